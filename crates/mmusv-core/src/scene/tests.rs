@@ -449,3 +449,38 @@ fn every_simd_level_gives_the_same_bits() {
 }
 
 mod waves;
+
+#[test]
+fn a_moving_instance_swaying_at_the_edge_of_the_scene_keeps_the_horizons() {
+    // A map's last buoy, tilting with the waves, took its box past the height grid (built round every instance
+    // as they stood): a moving box outside the grid turned every viewpoint's horizon off.
+    let ok = |r: Result<()>| r.unwrap_or_else(|e| unreachable!("{e}"));
+    let (mut s, vessels) = sea_world();
+    let mut rng = ChaCha8Rng::seed_from_u64(8);
+    scatter(&mut s, &vessels, &mut rng, [0.3, 0.0, 0.0]);
+    let v = vessels[0];
+    let others = (0..s.instances.len() as u32).filter(|&i| i != 1 && i != v);
+    let lo = others.map(|i| s.world_aabbs[i as usize].mins.x).fold(f32::INFINITY, f32::min);
+    let at = [f64::from(lo) - 40.0, 0.0, 0.3];
+    let yaw = std::f64::consts::FRAC_PI_2; // beam across x: a roll sweeps the hull's height into -x
+    ok(s.set_poses(&[v], &[RigidPose::from_xyz_rpy(at, [0.0, 0.0, yaw])]));
+    let mut with = s.clone();
+    ok(with.set_sea(1, &vessels));
+    let eye = [0.0, 0.0, 3.0];
+    assert!(with.horizon(eye).is_some());
+    // It tilts 10° where it stands: its box reaches past where it was, and past every other instance.
+    let rest = with.world_aabbs[v as usize].mins.x;
+    let tilted = RigidPose::from_xyz_rpy(at, [-0.17, 0.0, yaw]);
+    ok(s.set_poses(&[v], &[tilted]));
+    ok(with.set_poses(&[v], &[tilted]));
+    assert!(with.world_aabbs[v as usize].mins.x < rest - 0.1, "{rest} {}", with.world_aabbs[v as usize].mins.x);
+    assert!(with.horizon(eye).is_some(), "the tilted instance turned the horizons off");
+    let dirs: Vec<[f32; 3]> = (0..720)
+        .map(|k| {
+            let (az, el) = (k as f32 * 0.0523, (k % 9) as f32 * 0.1 - 0.2);
+            [az.cos() * el.cos(), az.sin() * el.cos(), el.sin()]
+        })
+        .collect();
+    let o = vec![eye; dirs.len()];
+    assert_eq!(s.cast_rays(&o, &dirs, 900.0).ok(), with.cast_rays(&o, &dirs, 900.0).ok());
+}
