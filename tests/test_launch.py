@@ -181,6 +181,44 @@ def test_a_stop_a_library_swallows_still_ends_the_run_in_one_line(tmp_path: Path
     assert out.stdout.splitlines()[-1] == "[0, 1]"  # no frame captured after the stop
 
 
+def test_a_stop_a_library_swallows_still_ends_the_conversion(tmp_path: Path) -> None:
+    # As for the recording (above): mmusv convert's frame loop raises a noted stop again.
+    scenario = {
+        "name": "tiny", "seed": 1, "acquisition": {"frequency_hz": 5, "frames": 6},
+        "map": {"type": "open_sea", "seed": 0, "params": {"extent_m": 800, "islet_probability": 0.0, "n_buoys": 0}},
+        "rigs": {"r": {"preset": "lidar_only"}},
+        "vessels": [
+            {"id": "usv", "role": "usv", "asset": "usv_wamv", "rig": "r", "speed_mps": 2.0, "route": [[0, 0], [90, 0]]},
+            {"id": "tug", "role": "target", "asset": "tug_32m", "speed_mps": 2.0, "route": [[40, 20], [140, 20]]},
+        ],
+    }  # fmt: skip
+    code = (
+        "import os, signal, sys, time\n"
+        "from mmusv.acquire import run\n"
+        f"res = run({scenario!r}, out_dir={str(tmp_path / 'rec')!r})\n"
+        f"sys.argv = ['mmusv', 'convert', str(res.recording), '--to', 'kitti', '-o', {str(tmp_path / 'kitti')!r}, "
+        "'--no-progress']\n"
+        "import mmusv.export.conversion as conversion\n"
+        "class Stream(conversion.FrameStream):\n"
+        "    def __iter__(self):\n"
+        "        for k, frame in enumerate(super().__iter__()):\n"
+        "            if k == 2:\n"
+        "                try:\n"
+        "                    os.kill(os.getpid(), signal.SIGINT)\n"
+        "                    time.sleep(5)\n"
+        "                except KeyboardInterrupt:\n"
+        "                    pass  # swallowed\n"
+        "            print('frame', k, flush=True)\n"
+        "            yield frame\n"
+        "conversion.FrameStream = Stream\n"
+        "from mmusv._launch import main\nsys.exit(main())\n"
+    )
+    out = _python(code)
+    assert out.stderr.endswith("mmusv: interrupted\n"), out.stderr
+    assert out.returncode == 130
+    assert [line for line in out.stdout.splitlines() if line.startswith("frame")] == ["frame 0", "frame 1", "frame 2"]
+
+
 def test_the_parser_every_command_builds_loads_no_scenario_model_or_dataset_reader() -> None:
     # mmusv --help took 1.5-1.9 s here: the parser imported the detection dataset reader for one constant (0.7 s),
     # the generator's sampler and map builder (0.26 s), and the scenario models for a warning class

@@ -110,6 +110,7 @@ def raise_noted_stop() -> None:
     """Raises ``KeyboardInterrupt`` if a stop was noted (:func:`note_stop`) and the work is still going: the one
     the handler raised was swallowed where it landed. A Ctrl-C that came while a frame's lazy import ran raised
     inside importlib's module-lock callback, which Python reports as "Exception ignored" and goes on: the run went
-    on to its last frame (1 of 200 starts of ``mmusv run`` under load). Long loops call this once a step."""
+    on to its last frame (1 of 200 starts of ``mmusv run`` under load). The recording's and the converter's frame
+    loops call this once a frame."""
     if _stop:
         raise KeyboardInterrupt

@@ -58,6 +58,7 @@ from mmusv.export.convert_report import REPORT_NAME, ConvertReport, RecordingRep
 from mmusv.export.convert_report import load_report as load_report  # importable from here as before
 from mmusv.export.splits import DEFAULT_RATIOS, SPLIT_NAMES, assign_splits, parse_ratios
 from mmusv.export.writer import DatasetWriter
+from mmusv.held_signals import raise_noted_stop
 from mmusv.recording.info import RecordingInfo, read_info
 from mmusv.recording.stream import FrameStream, held_text
 from mmusv.text import counted, given, named
@@ -389,6 +390,7 @@ def convert(
                     converted: set[int] = set()
                     incomplete: dict[int, str] = {}
                     for fr in stream:
+                        raise_noted_stop()  # a stop whose KeyboardInterrupt a library swallowed (held_signals)
                         missing = writer.missing(fr)
                         if not options.wants_frame(fr.index):
                             pass  # outside --frames: neither converted nor missing
