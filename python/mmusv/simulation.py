@@ -99,15 +99,18 @@ class Simulation:
             # The physical sea (``environment.motion: physical``, the default) displaces the water every sensor sees;
             # with ``motion: paper`` the water stays the flat plane of the paper.
             self.sea: SeaState | None = None
+            # The wave field the map's buoys ride (mmusv.world.buoys), as the moored ships do: the scenario's own sea
+            # where it is physical and has height; with `motion: paper` (the paper's flat water) they stand at rest.
+            self._buoy_field: Any | None = None
             if sc.environment.motion == "physical":
                 spec = sc.environment.sea_spec()
                 self.sea = spec if spec.hs_m > 0.0 else None
+                if spec.hs_m > 0.0 and len(self.world.priors.buoys):
+                    self._buoy_field = spec.field(scenario_seed=sc.seed)
             self.sensor_env: core.SensorEnv = self._sensor_env()
             poses0 = np.asarray(self.fleet.poses_at_times(np.zeros(1)))[0]
             # Over a physical sea the moored ships heave, roll and pitch at their berths (motion.build_moored_fleet).
             self._moored_fleet = build_moored_fleet(sc, self.world.moored)
-            # and the map's buoys ride its waves (mmusv.world.buoys).
-            self._buoy_field = self._riding_buoys()
             self.ws: WorldScene = build_world_scene(
                 self.world,
                 [(v.asset, v.role) for v in sc.vessels],
@@ -213,15 +216,6 @@ class Simulation:
         if self.sea is None:
             self.ws.scene.set_wave_surface(None, scenario_seed=self.scenario.seed, time_s=0.0, foci=np.zeros((0, 2)))
         self._frame = None
-
-    def _riding_buoys(self) -> Any | None:
-        """The wave field (``mmusv._core.WaveField``) the map's buoys ride, as the moored ships do: the scenario's
-        own sea where it is physical and has height and the map has buoys; ``None`` where they stand at rest (with
-        ``motion: paper`` the water is the paper's flat plane)."""
-        env = self.scenario.environment
-        if env.motion != "physical" or len(self.world.priors.buoys) == 0 or env.sea_spec().hs_m <= 0.0:
-            return None
-        return env.sea_spec().field(scenario_seed=self.scenario.seed)
 
     def _sensor_env(self) -> core.SensorEnv:
         """The sensors' view of the environment, whose sea state (their wind, whitecaps, water returns and

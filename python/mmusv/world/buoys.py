@@ -24,16 +24,17 @@ from mmusv.frames import pose_matrices
 __all__ = ["buoy_matrices", "buoy_poses"]
 
 
-def buoy_poses(field: Any, xy: npt.ArrayLike, t: float) -> npt.NDArray[np.float64]:
+def buoy_poses(field: Any | None, xy: npt.ArrayLike, t: float) -> npt.NDArray[np.float64]:
     """``(B, 6)`` float64 poses ``[x, y, z, roll, pitch, yaw]`` (world frame, metres, radians; yaw 0, the buoys
     being round) of ``B`` buoys at rest positions ``xy`` ``(B, 2)`` (world metres) riding the wave field ``field``
     (a ``mmusv._core.WaveField``) at time ``t`` (s): ``z`` the elevation at each buoy and the rotation
     ``Ry(pitch)·Rx(roll)`` taking the buoy's axis to the surface normal (the module's model); the body's origin is
-    its waterline point, so at rest ``[x, y, 0, 0, 0, 0]``."""
+    its waterline point, so at rest ``[x, y, 0, 0, 0, 0]``, as where ``field`` is ``None`` (a still sea, or
+    ``motion: paper``)."""
     p = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
     out = np.zeros((p.shape[0], 6), dtype=np.float64)
     out[:, :2] = p
-    if p.shape[0] == 0:
+    if field is None or p.shape[0] == 0:
         return out
     x, y = np.ascontiguousarray(p[:, 0]), np.ascontiguousarray(p[:, 1])
     out[:, 2] = np.asarray(field.elevation(x, y, float(t)), dtype=np.float64)
@@ -46,11 +47,5 @@ def buoy_poses(field: Any, xy: npt.ArrayLike, t: float) -> npt.NDArray[np.float6
 
 
 def buoy_matrices(field: Any | None, xy: npt.ArrayLike, t: float) -> npt.NDArray[np.float64]:
-    """``(B, 4, 4)`` float64 body -> world matrices of :func:`buoy_poses`; at rest (``[x, y, 0]``, no rotation)
-    where ``field`` is ``None`` (a still sea, or ``motion: paper``)."""
-    if field is None:
-        p = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
-        eta = np.zeros((p.shape[0], 6), dtype=np.float64)
-        eta[:, :2] = p
-        return pose_matrices(eta)
+    """``(B, 4, 4)`` float64 body -> world matrices of :func:`buoy_poses` (at rest where ``field`` is ``None``)."""
     return pose_matrices(buoy_poses(field, xy, t))
