@@ -110,7 +110,9 @@ def raise_noted_stop() -> None:
     """Raises ``KeyboardInterrupt`` if a stop was noted (:func:`note_stop`) and the work is still going: the one
     the handler raised was swallowed where it landed. A Ctrl-C that came while a frame's lazy import ran raised
     inside importlib's module-lock callback, which Python reports as "Exception ignored" and goes on: the run went
-    on to its last frame (1 of 200 starts of ``mmusv run`` under load). The recording's and the converter's frame
-    loops call this once a frame."""
+    on to its last frame (1 of 200 starts of ``mmusv run`` under load). Every long loop calls this once a step: the
+    recording's and the converter's frames, the generator's attempts, the batch's finished scenarios, the wave
+    studies' settings, the detection study's frames (and its jobs' results), the training's steps (and its jobs'
+    models)."""
     if _stop:
         raise KeyboardInterrupt

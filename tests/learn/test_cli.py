@@ -11,6 +11,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 import pytest
 import torch
@@ -199,3 +200,28 @@ def _running(pid: int) -> bool:
     except (OSError, IndexError):
         return False
     return state != "Z"
+
+
+def test_a_stop_swallowed_while_the_jobs_trained_ends_the_command(
+    recording: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # A stop whose KeyboardInterrupt a library swallowed (noted by the command's handler, then not raised) waited
+    # for every model and wrote the summary; it is raised again as each model finishes, and the others stop.
+    import concurrent.futures
+
+    from mmusv.held_signals import note_stop
+
+    original = concurrent.futures.as_completed
+
+    def as_completed(*args: Any, **kwargs: Any) -> Any:
+        for future in original(*args, **kwargs):
+            note_stop(signal.SIGINT)
+            yield future
+
+    monkeypatch.setattr(concurrent.futures, "as_completed", as_completed)  # imported where it runs
+    try:
+        code = _train(recording, tmp_path / "side", "--jobs", "3", "--threads", "1")
+    finally:
+        note_stop(None)
+    assert code == 130
+    assert not (tmp_path / "side" / "train_summary.json").exists()

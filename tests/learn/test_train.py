@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -145,3 +146,30 @@ def test_a_model_trained_further_than_asked_is_kept_and_said_so(
     out = capsys.readouterr().out
     assert "has trained 2 epochs, more than the 1 asked for: it is kept as it is" in out, out
     assert r.epochs == 2 and (tmp_path / "model.pt").read_bytes() == before
+
+
+def test_a_stop_swallowed_in_a_step_ends_the_training(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # A stop whose KeyboardInterrupt a library swallowed (noted by the command's handler, then not raised) went on
+    # training to the last epoch; the next step raises it again (held_signals.raise_noted_stop).
+    import signal
+
+    import mmusv.learn.train as train_module
+    from mmusv.held_signals import note_stop
+
+    calls: list[int] = []
+    original = train_module.centerpoint_loss
+
+    def loss(*args: Any, **kwargs: Any) -> Any:
+        calls.append(len(calls))
+        note_stop(signal.SIGINT)
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(train_module, "centerpoint_loss", loss)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            train(
+                MemorySource(SCENES[:2]), p=preset("tiny"), mode="single", out=tmp_path / "m", epochs=3, progress=False
+            )
+    finally:
+        note_stop(None)
+    assert calls == [0]

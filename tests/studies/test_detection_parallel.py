@@ -95,3 +95,30 @@ def test_the_python_api_names_its_own_arguments() -> None:
     for bad, said in ((0, "jobs = 0: must be a whole number"), ("2", "not str")):
         with pytest.raises(InputError, match=re.escape(said)):
             run_study_jobs(None, options=None, spec=None, jobs=bad)  # type: ignore[arg-type]
+
+
+def test_a_stop_swallowed_while_the_jobs_ran_ends_the_study(
+    two_sequences: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # A stop whose KeyboardInterrupt a library swallowed (noted by the command's handler, then not raised) ended
+    # nothing: the study merged the workers' results and wrote its tables. It is raised again after the wait.
+    import signal
+
+    import mmusv.studies.detection.parallel as parallel
+    from mmusv.held_signals import note_stop
+
+    original = parallel.wait
+
+    def wait(*args: object, **kwargs: object) -> object:
+        done = original(*args, **kwargs)  # type: ignore[arg-type]
+        note_stop(signal.SIGINT)
+        return done
+
+    monkeypatch.setattr(parallel, "wait", wait)
+    out = tmp_path / "det"
+    try:
+        code = main(["study", "detection", str(two_sequences), "--jobs", "2", "-o", str(out), "--no-progress"])
+    finally:
+        note_stop(None)
+    assert code == 130
+    assert not (out / "detection_table.csv").exists()

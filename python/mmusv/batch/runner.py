@@ -46,6 +46,7 @@ from mmusv.batch.index import (
 from mmusv.batch.plan import ScenarioPlan, plan_scenarios, prepare, scenario_files, task_complete
 from mmusv.batch.task import TaskResult
 from mmusv.errors import ConfigError, IoError, MmusvError
+from mmusv.held_signals import raise_noted_stop
 from mmusv.recording.guard import FolderLock
 
 __all__ = ["BatchReport", "ScenarioOutcome", "run_many"]
@@ -407,6 +408,7 @@ def _run(
         tries = dict.fromkeys(by_key, 1)
         lost_tries = dict.fromkeys(by_key, 0)
         while executor.in_flight():
+            raise_noted_stop()  # a stop whose KeyboardInterrupt a library swallowed (held_signals)
             task, res = executor.next_done()
             plan = plan_of[task.key]
             if res.status != "done" and res.disk_full and stop_on_full_disk and full_disk is None:

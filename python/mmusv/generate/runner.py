@@ -40,6 +40,7 @@ from mmusv.generate.sampler import Candidate, sample_candidate
 from mmusv.generate.samples import take_samples
 from mmusv.generate.spec import load_spec
 from mmusv.generate.spec_models import GenerationSpec, class_assets
+from mmusv.held_signals import raise_noted_stop
 
 __all__ = ["JOURNAL", "Progress", "check_output", "dump_scenario", "generate", "infeasible_error"]
 
@@ -407,6 +408,7 @@ def generate(
         for attempt in range(rep.max_attempts):
             if rep.met:
                 break
+            raise_noted_stop()  # a stop whose KeyboardInterrupt a library swallowed (held_signals)
             name = f"{rep.name}_{rep.accepted:0{width}d}"
             total_attempts += 1
             try:

@@ -30,6 +30,7 @@ from pathlib import Path
 from typing import Any
 
 from mmusv.errors import InputError
+from mmusv.held_signals import raise_noted_stop
 from mmusv.jsonio import read_json_or_none
 from mmusv.learn.modes import MODELS, models_for
 from mmusv.learn.scorer_fit import fit_scorers
@@ -245,6 +246,7 @@ def _run(args: argparse.Namespace, stack: contextlib.ExitStack) -> int:
             futures = {pool.submit(_train_one, {**task, "mode": mode, "out": str(out / mode)}): mode for mode in modes}
             try:
                 for f in as_completed(futures):
+                    raise_noted_stop()  # a stop whose KeyboardInterrupt a library swallowed (held_signals)
                     try:
                         done[futures[f]] = f.result()
                     except Exception as e:  # reported here, the first one raised after the others

@@ -50,6 +50,7 @@ from typing import Any
 import numpy as np
 import torch
 
+from mmusv.held_signals import raise_noted_stop
 from mmusv.learn._errors import input_error
 from mmusv.learn.augment import apply, draw
 from mmusv.learn.cache import Cache
@@ -276,6 +277,7 @@ def train(
         model.train()
         stopped = False
         for batch in loader:
+            raise_noted_stop()  # a stop whose KeyboardInterrupt a library swallowed (held_signals)
             elapsed = time.perf_counter() - t0
             prog = step / max(1, n_epochs * steps_per_epoch)
             if time_limit_s:

@@ -30,6 +30,7 @@ from mmusv import arguments
 from mmusv.config import AcquisitionConfig, Scenario
 from mmusv.errors import ConfigError
 from mmusv.forking import check_polars
+from mmusv.held_signals import raise_noted_stop
 from mmusv.jsonio import write_files_atomic
 from mmusv.motion import scenario_poses
 from mmusv.world.environment import WAVE_PRESETS, wave_height_m
@@ -157,6 +158,7 @@ def run_wave_study(
     scenario = scenario.with_sea(None, motion=motion)
     rows = []
     for w in waves:
+        raise_noted_stop()  # a stop whose KeyboardInterrupt a library swallowed (held_signals)
         poses = scenario_poses(scenario, wave=w, reference_usvs=usvs == "reference")[:, usv_idx, :]
         heave, roll, pitch = _rms_stats(poses)
         rows.append(
@@ -249,6 +251,7 @@ def run_physical_wave_study(
     paper = scenario.with_sea(None, motion="paper")
     rows, vessel_rows = [], []
     for w in waves:
+        raise_noted_stop()
         p_phys = scenario_poses(physical, wave=w)
         p_paper = scenario_poses(paper, wave=w)[:, usv_idx, :]
         phys_usv = _rms_stats(p_phys[:, usv_idx, :])

@@ -26,6 +26,7 @@ from typing import Any
 from mmusv import arguments
 from mmusv.batch.executors import refuse_in_daemon, workers_skip_unimportable_main
 from mmusv.errors import InputError, MmusvError
+from mmusv.held_signals import raise_noted_stop
 from mmusv.studies.detection.sources import Dataset
 from mmusv.studies.detection.study import StudyOptions, StudyResult, check_predictions_used, run_study
 from mmusv.text import command_line, flags, given, named
@@ -124,6 +125,7 @@ def run_study_jobs(
             }
         while pending:
             finished, _ = wait(pending, return_when=FIRST_COMPLETED)
+            raise_noted_stop()  # a stop whose KeyboardInterrupt a library swallowed (held_signals)
             for fut in finished:
                 name = pending.pop(fut)
                 status, value, nbytes = fut.result()

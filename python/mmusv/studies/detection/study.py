@@ -48,6 +48,7 @@ from mmusv.boxes3d import in_target_range
 from mmusv.errors import InputError
 from mmusv.forking import check_polars
 from mmusv.frames import transform_points
+from mmusv.held_signals import raise_noted_stop
 from mmusv.studies.detection.data import (
     AgentFrame,
     SceneFrame,
@@ -456,6 +457,7 @@ def run_study(
         keys = [(s.name, m) for s in o.settings for m in modes if m != "none" or s.name == "clean"]
         own = _OwnDetections(o.detector)
         for t, frame in enumerate(seq.frames):
+            raise_noted_stop()  # a stop whose KeyboardInterrupt a library swallowed (held_signals)
             if any(seq.frame_at(frame.frame - d) is None for d in delays):
                 continue  # a delay has no frame k - d here: left out for every setting
             res.frames += 1
