@@ -109,6 +109,27 @@ def test_another_seed_gives_other_scenarios(small_run: tuple[Path, dict[str, Any
         assert p.read_bytes() != (out / p.name).read_bytes()
 
 
+def test_a_combination_keeps_its_scenarios_when_the_others_are_added_removed_or_moved(
+    small_run: tuple[Path, dict[str, Any]], tmp_path: Path
+) -> None:
+    # The seeds of a combination's draws came from its place in the list: a combination put before it (or one
+    # before it removed) gave it other scenarios, other seeds and other distractor counts. They come from its name.
+    out, _ = small_run
+    head_on, convoy, occluded = SMALL["combinations"][1:4]
+    added = {"family": "overtaking", "difficulty": "easy", "targets": ["small"], "quota": 1}
+    spec = dict(SMALL, combinations=[added, occluded, convoy, head_on])
+    generate(spec, tmp_path)
+    kept = [p for p in sorted(out.glob("*.yaml")) if not p.name.startswith("crossing_")]
+    assert len(kept) == 5
+    for p in kept:
+        assert (tmp_path / p.name).read_bytes() == p.read_bytes(), p.name
+    report = json.loads((tmp_path / "report.json").read_text(encoding="utf-8"))
+    ours = {s["file"]: s for s in json.loads((out / "report.json").read_text(encoding="utf-8"))["scenarios"]}
+    for s in report["scenarios"]:
+        if s["file"] in ours:
+            assert s == ours[s["file"]]  # the same attempt, seed and roles
+
+
 def test_impossible_spec_ends_with_a_clear_report(tmp_path: Path) -> None:
     t0 = time.perf_counter()
     rep = generate(SPECS / "impossible_port.yaml", tmp_path)

@@ -1,9 +1,10 @@
 """The reject-and-resample loop: fill every combination's quota or stop at its attempt cap, write the accepted
 scenarios and ``report.json``.
 
-Per combination ``i`` (in spec order) attempts ``0, 1, ...`` are drawn by :func:`sample_candidate` from
-``(spec.seed, i, attempt)`` (the distractor count from the place in the quota being filled) and checked by the
-enabled constraints; an accepted candidate is written as
+Per combination (in spec order) attempts ``0, 1, ...`` are drawn by :func:`sample_candidate` from
+``(spec.seed, the combination's name, attempt)`` (the distractor count from the place in the quota being filled;
+the name, not the place in the list: the others' scenarios stay when one is added, removed or moved) and checked
+by the enabled constraints; an accepted candidate is written as
 ``<combination>_<NNN>.yaml`` (``NNN`` = its rank among the combination's accepted scenarios; its name goes into
 the hidden ``.generate.partial`` first, so a run stopped before its report is known by ``--force``), read back (YAML
 safe loader, libyaml's when installed: the same resolver as ``yaml.safe_load``), validated with

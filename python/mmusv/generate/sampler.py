@@ -1,9 +1,10 @@
 """The sampler: one candidate scenario per (spec, combination, attempt), deterministically.
 
-The random generator of an attempt is ``numpy.random.default_rng(SeedSequence([spec.seed, combination index,
+The random generator of an attempt is ``numpy.random.default_rng(SeedSequence([spec.seed, combination key,
 attempt]))``, so a candidate does not depend on what other combinations or attempts drew, but for its number of
 distractors, drawn for its place in the quota (:func:`extra_count`) so that the accepted scenarios have the counts
-the spec asks for. The sampler draws the
+the spec asks for. The combination key comes from the combination's name (:func:`combination_key`), not from its
+place in the list: a combination added, removed or moved leaves the scenarios of the others as they were. The sampler draws the
 environment choices, the assets and nominal speeds of every role, an encounter centre in open water (map priors),
 lets the family template lay out the routes, scatters the difficulty's distractor targets around the centre and
 assembles a scenario dict with every number rounded (metres and m/s to 0.01) in a fixed key order, validated
@@ -12,6 +13,7 @@ with :func:`mmusv.config.load_scenario`. Units: metres, seconds, m/s; world fram
 
 from __future__ import annotations
 
+import hashlib
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -39,6 +41,7 @@ __all__ = [
     "Candidate",
     "CandidateMeta",
     "attempt_rng",
+    "combination_key",
     "extra_count",
     "hull_radius",
     "sample_candidate",
@@ -90,14 +93,21 @@ class Candidate:
     meta: CandidateMeta
 
 
-def attempt_rng(seed: int, *, combo_index: int, attempt: int) -> np.random.Generator:
-    """The random generator of one attempt (see module docstring)."""
-    return np.random.default_rng(np.random.SeedSequence([int(seed), int(combo_index), int(attempt)]))
+def combination_key(name: str) -> int:
+    """The key of a combination in every seed of its draws: the first 128 bits of the SHA-256 of its name
+    (:meth:`~mmusv.generate.spec_models.Combination.label`, unique in a spec), a whole number in ``[0, 2**128)``."""
+    return int.from_bytes(hashlib.sha256(name.encode("utf-8")).digest()[:16], "little")
 
 
-def scenario_seed(seed: int, *, combo_index: int, attempt: int) -> int:
+def attempt_rng(seed: int, *, combination: str, attempt: int) -> np.random.Generator:
+    """The random generator of one attempt of the combination named ``combination`` (see module docstring)."""
+    return np.random.default_rng(np.random.SeedSequence([int(seed), combination_key(combination), int(attempt)]))
+
+
+def scenario_seed(seed: int, *, combination: str, attempt: int) -> int:
     """The ``seed`` written into a scenario (wave phases etc.), in ``[0, 2**63)``, from the same triple."""
-    hi, lo = np.random.SeedSequence([int(seed), int(combo_index), int(attempt), 1]).generate_state(2, np.uint32)
+    entropy = [int(seed), combination_key(combination), int(attempt), 1]
+    hi, lo = np.random.SeedSequence(entropy).generate_state(2, np.uint32)
     return ((int(hi) << 32) | int(lo)) >> 1
 
 
@@ -151,16 +161,17 @@ def _vessel(t: Track, rig: str) -> dict[str, Any]:
     return out
 
 
-def extra_count(seed: int, *, combo_index: int, slot: int, extra: tuple[int, int]) -> int:
-    """The number of distractors of the ``slot``-th scenario of a combination's quota (0-based), uniform over
-    ``extra`` (the difficulty's ``extra_targets``), from ``SeedSequence([seed, combination index, slot, 2])``.
+def extra_count(seed: int, *, combination: str, slot: int, extra: tuple[int, int]) -> int:
+    """The number of distractors of the ``slot``-th scenario of the quota of the combination named
+    ``combination`` (0-based), uniform over ``extra`` (the difficulty's ``extra_targets``), from
+    ``SeedSequence([seed, combination key, slot, 2])``.
     Drawn per place in the quota, not per attempt: a candidate with more distractors fails the checks more often,
     so a count drawn anew at every attempt left the accepted scenarios with mostly few (39, 37, 16 and 8 of 100
     with 0, 1, 2 and 3 asked uniform)."""
     lo, hi = extra
     if lo == hi:
         return lo
-    rng = np.random.default_rng(np.random.SeedSequence([int(seed), int(combo_index), int(slot), 2]))
+    rng = np.random.default_rng(np.random.SeedSequence([int(seed), combination_key(combination), int(slot), 2]))
     return int(rng.integers(lo, hi + 1))
 
 
@@ -174,7 +185,8 @@ def sample_candidate(
     combo: Combination = spec.combinations[combo_index]
     fam = FAMILIES[combo.family]
     diff = spec.difficulties[combo.difficulty]
-    rng = attempt_rng(spec.seed, combo_index=combo_index, attempt=attempt)
+    key = combo.label()  # the seeds' key: the combination's name, not its place in the list
+    rng = attempt_rng(spec.seed, combination=key, attempt=attempt)
     acq = spec.acquisition
     duration = max((acq.frames - 1) / acq.frequency_hz, 1.0 / acq.frequency_hz)
     cons = spec.constraints
@@ -220,7 +232,7 @@ def sample_candidate(
     # (drawn from the attempt's generator either way, so that its later draws stay where they were)
     n_extra = int(rng.integers(diff.extra_targets[0], diff.extra_targets[1] + 1))
     if slot is not None:  # the count for the candidate's place in the quota
-        n_extra = extra_count(spec.seed, combo_index=combo_index, slot=slot, extra=diff.extra_targets)
+        n_extra = extra_count(spec.seed, combination=key, slot=slot, extra=diff.extra_targets)
     classes = diff.extra_classes or list(spec.size_classes)
     reach = max(diff.range_m[1], 150.0)
     distractors = []
@@ -244,7 +256,7 @@ def sample_candidate(
     tracks.sort(key=lambda t: (order[t.role.role], 0 if t.role.id == "usv_ego" else 1))
     data: dict[str, Any] = {
         "name": name,
-        "seed": scenario_seed(spec.seed, combo_index=combo_index, attempt=attempt),
+        "seed": scenario_seed(spec.seed, combination=key, attempt=attempt),
         "map": {"type": map_cfg.type, "seed": map_cfg.seed, "params": map_cfg.param_values()},
         "environment": env,
         "acquisition": {"frequency_hz": acq.frequency_hz, "frames": acq.frames},
