@@ -59,9 +59,9 @@ def label_words(semantic_class: np.ndarray, instance: np.ndarray) -> np.ndarray:
 def vessel_instances(instance: np.ndarray, world: WorldFrame) -> np.ndarray:
     """``(N,)`` int64: the points' instance ids where they hit a vessel of the world state (scenario vessels, USVs,
     moored ships: their ``instance_id``, the one COCO's masks use), 0 elsewhere. The recorded ``instance`` is the
-    scene instance of the surface hit, and water, land, structures and buoys are scene instances too (the sea is
-    typically 1, the first static mesh 0), so without this the sea would read as one SemanticKITTI instance and a
-    buoy as none."""
+    scene instance of the surface hit, and water, land, structures and buoys are scene instances too (each buoy
+    one of its own, the first of them 0, else the first static mesh), so without this the sea would read as one
+    SemanticKITTI instance and every buoy but the first as one too."""
     inst = np.asarray(instance).astype(np.int64)
     ids = np.asarray(world.instance_ids, dtype=np.int64)
     return np.where(np.isin(inst, ids), inst, 0)

@@ -7,7 +7,8 @@ Ships and Offshore Structures*, Cambridge University Press, ch. 2–3). Where a 
 3.5–9.3 s, are 19–136 m long) its heave RAO tends to 1 and it stays normal to the surface: the buoy's waterline
 point rises and falls with the elevation ``η(x, y, t)`` of the wave field at its position, and its axis is the
 surface's normal ``(−∂η/∂x, −∂η/∂y, 1)``. Not modelled: the heave and roll resonances of the float itself (a
-2.5 m draft gives a heave period of about 3.5 s, near the W0 sea's peak), its mooring's pull and its drift.
+1 m draft, ``mmusv.world.port.buoy_mesh``'s, gives a heave period of about 2.5 s with the added mass of its 1.2 m
+radius, shorter than the W0 sea's 3.5 s peak period), its mooring's pull and its drift.
 
 Over a still sea, or with ``motion: paper`` (the paper's water is a flat plane), the buoys stand at rest.
 """
