@@ -299,10 +299,33 @@ def buoys(out: Path, lines: list[str]) -> None:
             assert rgb is not None
             tiles.append(np.asarray(rgb))
             water = float(sim.ws.scene.wave_heights(np.array([[bx, by]]))[0])
-            line = float(sim.ws.scene.instance_pose(sim.ws.buoy_instances[0])[2, 3])
-            lines.append(f"| {name} | {frame} | {water:+.2f} | {line:+.2f} |")
+            pose = sim.ws.scene.instance_pose(sim.ws.buoy_instances[0])
+            tilt = float(np.degrees(np.arccos(np.clip(pose[2, 2], -1.0, 1.0))))
+            lines.append(f"| {name} | {frame} | {water:+.2f} | {pose[2, 3]:+.2f} | {tilt:.1f} |")
         rows.append(np.concatenate(tiles, axis=1))
     Image.fromarray(np.concatenate(rows, axis=0)).save(out / "buoy_w3.png")
+    # The tilt over many buoys and times, per sea state: the surface normal at the buoy's centre (the first model,
+    # 2026-12-06) against the plane fitted over its waterplane (now) and the rms slope of the waves at least twice
+    # the float's diameter long (the linear sea's sum of a^2 k^2 / 2 over them).
+    from mmusv.world.buoys import buoy_matrices
+    from mmusv.world.port import BUOY_FLOAT_RADIUS_M
+    from mmusv.world.sea_state import sea_spec_for_preset
+
+    xy = np.random.default_rng(1).uniform(-400.0, 400.0, size=(200, 2))
+    lines += ["", "| sea state | tilt rms, normal at the centre (deg) | tilt rms, waterplane (deg) | max, waterplane "
+              "(deg) | rms slope of the waves >= 2 diameters (deg) |", "|---|---|---|---|---|"]  # fmt: skip
+    for wave in ("W0", "W1", "W2", "W3"):
+        f = sea_spec_for_preset(wave).field(scenario_seed=7)
+        a, _, k, _, _ = np.asarray(f.components()).T
+        long = np.degrees(np.sqrt(np.sum((a**2 * k**2 / 2.0)[2.0 * np.pi / k >= 4.0 * BUOY_FLOAT_RADIUS_M])))
+        point, plane = [], []
+        for t in np.arange(0.0, 20.0, 0.4):
+            s = f.slope(xy[:, 0].copy(), xy[:, 1].copy(), float(t))
+            point.append(np.degrees(np.arctan(np.hypot(s[:, 0], s[:, 1]))))
+            plane.append(np.degrees(np.arccos(np.clip(buoy_matrices(f, xy, float(t))[:, 2, 2], -1.0, 1.0))))
+        pt, pl = np.concatenate(point), np.concatenate(plane)
+        rms_pt, rms_pl = np.sqrt(np.mean(pt**2)), np.sqrt(np.mean(pl**2))
+        lines.append(f"| {wave} | {rms_pt:.1f} | {rms_pl:.1f} | {pl.max():.1f} | {long:.1f} |")
 
 
 def main() -> None:
@@ -325,7 +348,7 @@ def main() -> None:
         ),
         "radar": ("| sea state | sea | clutter returns | 95th percentile clutter range (m) |", radar_ppi),
         "wake": ("| sweep | water returns | vessel returns |", lidar_wake),
-        "buoys": ("| buoys | frame | water at the buoy (m) | the buoy's waterline (m) |", buoys),
+        "buoys": ("| buoys | frame | water at the buoy (m) | the buoy's waterline (m) | its tilt (deg) |", buoys),
     }
     only = [p.strip() for p in args.only.split(",") if p.strip()]
     unknown = sorted(set(only) - set(parts))

@@ -218,16 +218,6 @@ def _tilts_deg(field: Any, xy: np.ndarray, times: np.ndarray) -> np.ndarray:
     return np.degrees(np.concatenate([np.arccos(buoy_matrices(field, xy, t)[:, 2, 2]) for t in times]))
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="the buoys tilt with waves shorter than the float: buoy_poses takes the axis from the full field's "
-    "slope at one point, whose variance is mostly waves of 0.2-12 m (94 % of it at W0, 76 % at W1), so a 2.4 m "
-    "float tilts 8 degrees rms (up to 27) at every sea state from W0 (Hs 0.5 m) to W3 alike and jitters by 3-4 "
-    "degrees from frame to frame; the long-wavelength limit the module cites holds only for waves much longer "
-    "than the body. Fix: weight each component by the float's waterplane average 2 J1(kR)/(kR), R = 1.2 m (or "
-    "leave out the waves shorter than a few diameters) in the buoy's elevation and slope (field.components(); the "
-    "tests of test_buoys.py and the docs table follow the filtered surface then)",
-)
 def test_a_buoy_does_not_tilt_with_waves_shorter_than_itself() -> None:
     """At W0 (Hs 0.5 m, waves of 19 m at the peak) a 2.4 m float follows the waves at least twice its diameter
     long: its rms tilt is about that of those waves' slopes, not that of the ripples' (worked out from the field's

@@ -4,10 +4,10 @@ The random generator of an attempt is ``numpy.random.default_rng(SeedSequence([s
 attempt]))``, so a candidate does not depend on what other combinations or attempts drew, but for its number of
 distractors, drawn for its place in the quota (:func:`extra_count`) so that the accepted scenarios have the counts
 the spec asks for. The combination key comes from the combination's name (:func:`combination_key`), not from its
-place in the list: a combination added, removed or moved leaves the scenarios of the others as they were. The sampler draws the
-environment choices, the assets and nominal speeds of every role, an encounter centre in open water (map priors),
-lets the family template lay out the routes, scatters the difficulty's distractor targets around the centre and
-assembles a scenario dict with every number rounded (metres and m/s to 0.01) in a fixed key order, validated
+place in the list: a combination added, removed or moved leaves the scenarios of the others as they were. The
+sampler draws the environment choices, the assets and nominal speeds of every role, an encounter centre in open water
+(map priors), lets the family template lay out the routes, scatters the difficulty's distractor targets around the
+centre and assembles a scenario dict with every number rounded (metres and m/s to 0.01) in a fixed key order, validated
 with :func:`mmusv.config.load_scenario`. Units: metres, seconds, m/s; world frame.
 """
 

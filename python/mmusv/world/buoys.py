@@ -1,14 +1,21 @@
-"""Navigation buoys riding the physical sea: each buoy follows the water surface at its position.
+"""Navigation buoys riding the physical sea: each buoy follows the water surface over its waterplane.
 
-Model: **the long-wavelength limit of a small floating body** (Newman, J. N. (1977), *Marine Hydrodynamics*, MIT
-Press, ch. 6, the long-wavelength approximation of wave forces and motions; Faltinsen, O. M. (1990), *Sea Loads on
-Ships and Offshore Structures*, Cambridge University Press, ch. 2–3). Where a body is much smaller than the waves
-(a map's buoy is 2.4 m across; the shortest waves that carry the energy of the W0–W3 seas, at their peak periods of
-3.5–9.3 s, are 19–136 m long) its heave RAO tends to 1 and it stays normal to the surface: the buoy's waterline
-point rises and falls with the elevation ``η(x, y, t)`` of the wave field at its position, and its axis is the
-surface's normal ``(−∂η/∂x, −∂η/∂y, 1)``. Not modelled: the heave and roll resonances of the float itself (a
-1 m draft, ``mmusv.world.port.buoy_mesh``'s, gives a heave period of about 2.5 s with the added mass of its 1.2 m
-radius, shorter than the W0 sea's 3.5 s peak period), its mooring's pull and its drift.
+Model: **the quasi-static (hydrostatic, Froude–Krylov) response of a small floating disc**, the long-wavelength
+limit of a small floating body (Newman, J. N. (1977), *Marine Hydrodynamics*, MIT Press, ch. 6, the
+long-wavelength approximation of wave forces and motions; Faltinsen, O. M. (1990), *Sea Loads on Ships and
+Offshore Structures*, Cambridge University Press, ch. 2–3, the Froude–Kriloff force). A float whose resonances lie
+above the waves that move it (a map's buoy: a 1 m draft and a 1.2 m radius, ``mmusv.world.port.buoy_mesh``, give a
+heave period of about 2.5 s with the added mass, shorter than the W0 sea's 3.5 s peak period) is in hydrostatic
+balance with the water pressure over its waterplane at each instant: its waterline point rises to the **mean
+elevation over its waterplane disc** and its axis takes the normal of the **plane fitted to the surface over that
+disc** (least squares; hydrostatic pitch and roll moments of a waterplane whose restoring is its own second moment).
+For a plane wave ``a·cos(k·x − ωt + φ)`` over a disc of radius ``R`` these are the wave's elevation weighted by
+``2·J₁(kR)/(kR)`` and its slope weighted by ``8·J₂(kR)/(kR)²`` (the disc integrals of ``e^{ik·x}`` and of
+``x·e^{ik·x}``); both tend to 1 where ``kR → 0``, the surface-follower of the long-wavelength limit, and both
+leave out the waves shorter than the float, which move its waterline but not the float (without them a 2.4 m float
+tilted 8° rms, up to 27°, alike at every sea state from W0 to W3). Not modelled: the float's own heave and roll
+resonances and their dynamic amplification, the pressure's decay to the draft (``e^{−kd}``), its mooring's pull and
+its drift.
 
 Over a still sea, or with ``motion: paper`` (the paper's water is a flat plane), the buoys stand at rest.
 """
@@ -19,17 +26,33 @@ from typing import Any
 
 import numpy as np
 import numpy.typing as npt
+from scipy.special import jv
 
 from mmusv.frames import pose_matrices
+from mmusv.world.port import BUOY_FLOAT_RADIUS_M
 
-__all__ = ["buoy_matrices", "buoy_poses"]
+__all__ = ["buoy_matrices", "buoy_poses", "waterplane_weights"]
 
 
-def buoy_poses(field: Any | None, xy: npt.ArrayLike, t: float) -> npt.NDArray[np.float64]:
+def waterplane_weights(k: npt.ArrayLike, radius_m: float) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """The weights ``(heave, tilt)``, each float64 of ``k``'s shape, of plane waves of wavenumbers ``k`` (rad/m)
+    over a disc of radius ``radius_m`` (m): the disc's mean of ``e^{ik·x}``, ``2·J₁(kR)/(kR)``, and its least-squares
+    slope over the wave's, ``8·J₂(kR)/(kR)²`` (module docstring); 1 at ``k = 0``."""
+    x = np.asarray(k, dtype=np.float64) * float(radius_m)
+    safe = np.where(x > 1e-6, x, 1.0)
+    heave = np.where(x > 1e-6, 2.0 * jv(1, safe) / safe, 1.0 - x**2 / 8.0)
+    tilt = np.where(x > 1e-6, 8.0 * jv(2, safe) / safe**2, 1.0 - x**2 / 12.0)
+    return heave, tilt
+
+
+def buoy_poses(
+    field: Any | None, xy: npt.ArrayLike, t: float, *, radius_m: float = BUOY_FLOAT_RADIUS_M
+) -> npt.NDArray[np.float64]:
     """``(B, 6)`` float64 poses ``[x, y, z, roll, pitch, yaw]`` (world frame, metres, radians; yaw 0, the buoys
     being round) of ``B`` buoys at rest positions ``xy`` ``(B, 2)`` (world metres) riding the wave field ``field``
-    (a ``mmusv._core.WaveField``) at time ``t`` (s): ``z`` the elevation at each buoy and the rotation
-    ``Ry(pitch)·Rx(roll)`` taking the buoy's axis to the surface normal (the module's model); the body's origin is
+    (a ``mmusv._core.WaveField``) at time ``t`` (s) over a waterplane of radius ``radius_m`` (m): ``z`` the mean
+    elevation over the waterplane and the rotation ``Ry(pitch)·Rx(roll)`` taking the buoy's axis to the normal of
+    the plane fitted to the surface there (the module's model, from the field's components); the body's origin is
     its waterline point, so at rest ``[x, y, 0, 0, 0, 0]``, as where ``field`` is ``None`` (a still sea, or
     ``motion: paper``)."""
     p = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
@@ -37,16 +60,23 @@ def buoy_poses(field: Any | None, xy: npt.ArrayLike, t: float) -> npt.NDArray[np
     out[:, :2] = p
     if field is None or p.shape[0] == 0:
         return out
-    x, y = np.ascontiguousarray(p[:, 0]), np.ascontiguousarray(p[:, 1])
-    out[:, 2] = np.asarray(field.elevation(x, y, float(t)), dtype=np.float64)
-    s = np.asarray(field.slope(x, y, float(t)), dtype=np.float64).reshape(-1, 2)
-    # R·e_z = (sin p cos r, −sin r, cos p cos r) = (−ηx, −ηy, 1) / N (pose_matrices' R = Rz(yaw)·Ry(pitch)·Rx(roll)).
-    norm = np.sqrt(1.0 + s[:, 0] ** 2 + s[:, 1] ** 2)
-    out[:, 3] = np.arcsin(s[:, 1] / norm)
-    out[:, 4] = np.arctan(-s[:, 0])
+    a, omega, k, direction, phase0 = np.asarray(field.components(), dtype=np.float64).reshape(-1, 5).T
+    kx, ky = k * np.cos(direction), k * np.sin(direction)
+    heave, tilt = waterplane_weights(k, radius_m)
+    # the field's phase convention (mmusv_core::ocean::WaveComponent::phase_at): k·x − ωt + φ
+    phase = p[:, :1] * kx + p[:, 1:] * ky - omega * float(t) + phase0
+    out[:, 2] = np.cos(phase) @ (a * heave)
+    sin = np.sin(phase)
+    sx, sy = -(sin @ (a * tilt * kx)), -(sin @ (a * tilt * ky))
+    # R·e_z = (sin p cos r, −sin r, cos p cos r) = (−sx, −sy, 1) / N (pose_matrices' R = Rz(yaw)·Ry(pitch)·Rx(roll)).
+    norm = np.sqrt(1.0 + sx**2 + sy**2)
+    out[:, 3] = np.arcsin(sy / norm)
+    out[:, 4] = np.arctan(-sx)
     return out
 
 
-def buoy_matrices(field: Any | None, xy: npt.ArrayLike, t: float) -> npt.NDArray[np.float64]:
+def buoy_matrices(
+    field: Any | None, xy: npt.ArrayLike, t: float, *, radius_m: float = BUOY_FLOAT_RADIUS_M
+) -> npt.NDArray[np.float64]:
     """``(B, 4, 4)`` float64 body -> world matrices of :func:`buoy_poses` (at rest where ``field`` is ``None``)."""
-    return pose_matrices(buoy_poses(field, xy, t))
+    return pose_matrices(buoy_poses(field, xy, t, radius_m=radius_m))

@@ -22,7 +22,16 @@ from mmusv.world.primitives import TriMesh, box, cylinder, merge, transformed
 if TYPE_CHECKING:
     from mmusv.world.map_params import PortParams
 
-__all__ = ["Berth", "PortPlan", "buoy_mesh", "plan_port", "port_structures", "port_terrain", "tapered_wall"]
+__all__ = [
+    "BUOY_FLOAT_RADIUS_M",
+    "Berth",
+    "PortPlan",
+    "buoy_mesh",
+    "plan_port",
+    "port_structures",
+    "port_terrain",
+    "tapered_wall",
+]
 
 Ground = Callable[[np.ndarray], np.ndarray]
 """Terrain height (metres) at canonical points ``(N, 2)`` -> ``(N,)``."""
@@ -181,10 +190,15 @@ def _rx(a: float) -> np.ndarray:
     return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
 
 
+BUOY_FLOAT_RADIUS_M = 1.2
+"""The radius of a buoy's float (:func:`buoy_mesh`), metres: the waterplane over which it rides the waves
+(:mod:`mmusv.world.buoys`)."""
+
+
 def buoy_mesh(x: float, y: float) -> TriMesh:
     """A navigation buoy (class BUOY): a 1.2 m radius float with a conical top mark, 3.8 m above water."""
     cls = int(SemanticClass.BUOY)
-    body = cylinder(center=(x, y, -1.0), radius=1.2, height=3.0, cls=cls, segments=10)
+    body = cylinder(center=(x, y, -1.0), radius=BUOY_FLOAT_RADIUS_M, height=3.0, cls=cls, segments=10)
     mark = cylinder(center=(x, y, 2.0), radius=0.6, height=1.8, cls=cls, segments=6, top_radius=0.05)
     return merge([body, mark])
 
