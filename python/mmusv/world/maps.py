@@ -428,7 +428,8 @@ def generate_port(*, seed: int, params: PortParams | None = None) -> MapWorld:
             p.n_moored,
             f"at most {len(built.berths)} with this map seed and layout: the quay and piers of this port have free "
             f"berths for only {len(built.berths)} of the {p.n_moored} moored ships (lower n_moored, add piers with "
-            "n_piers, or give shorter moored_assets)",
+            "n_piers, or give shorter moored_assets, or ones whose draft is less than basin_depth_m: a ship "
+            "that would ground is not moored)",
         )
     _channel_fits(p, len(built.buoys) // 2)
     structures = [transformed(s, rotation=rot3) for s in built.parts]

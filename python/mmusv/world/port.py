@@ -65,11 +65,13 @@ class PortPlan:
 
 @dataclass(frozen=True)
 class Berth:
-    """A moored ship: library asset name, canonical pose ``(x, y, yaw)`` and its ``(length, beam)`` metres."""
+    """A moored ship: library asset name, canonical pose ``(x, y, yaw)`` and its ``(length, beam)`` metres;
+    ``face`` the unit vector (canonical frame) from its centre towards the quay or pier face it lies along."""
 
     asset: str
     pose: tuple[float, float, float]
     size: tuple[float, float]
+    face: tuple[float, float] = (0.0, 1.0)
 
     def footprint(self) -> Polygon:
         """Hull rectangle (shapely, metres, canonical frame)."""
@@ -381,9 +383,36 @@ def port_structures(p: PortParams, plan: PortPlan, *, ground: Ground, rng: np.ra
     return PortStructures(parts=parts, buoys=buoys, berths=berths)
 
 
+def _afloat(berth: Berth, p: PortParams) -> Berth | None:
+    """``berth`` where its ship floats in the basin (its draft, from its hull particulars as the ``under_keel``
+    check reads them, below ``basin_depth_m``), else the same berth holding the longest ship of ``p.moored_assets``
+    that fits its length and beam and floats (None where none does)."""
+    from mmusv.world.hydrostatics import hull_particulars
+    from mmusv.world.vessels import get_asset
+
+    def floats(name: str) -> bool:
+        return hull_particulars(get_asset(name))[2] < p.basin_depth_m
+
+    if floats(berth.asset):
+        return berth
+    length, beam = berth.size
+    fits = [a for a in p.moored_assets if a[1] <= length and a[2] <= beam and floats(a[0])]
+    if not fits:
+        return None
+    name, ship_length, ship_beam = max(fits, key=lambda a: (a[1], a[2]))
+    shift = (beam - ship_beam) / 2.0  # alongside the same face, as far off it as the berth's own ship lay
+    x, y, yaw = berth.pose
+    pose = (x + shift * berth.face[0], y + shift * berth.face[1], yaw)
+    return Berth(name, pose, (ship_length, ship_beam), berth.face)
+
+
 def _berths(p: PortParams, plan: PortPlan, parts: list[TriMesh], *, rng: np.random.Generator) -> list[Berth]:
     """Candidate berths along the terminal quay and both sides of every pier; ``n_moored`` of them chosen, or every
-    free one when fewer fit (:func:`mmusv.world.maps.generate_port` then refuses the map)."""
+    free one when fewer fit (:func:`mmusv.world.maps.generate_port` then refuses the map). A ship chosen for a
+    berth whose draft reaches the basin's floor (``basin_depth_m``: the 300 m container ship's 14.5 m in the default
+    14 m) gives way to the longest ship of ``moored_assets`` that fits the berth and floats, at the same berth (where
+    none does, the berth is passed over): until 2026-12-06 the default ports of 7 of the seeds 0-11 moored it with
+    its keel in the floor. No draw of its own: the ports whose ships floated are as they were."""
     if p.n_moored == 0:
         return []
     assets = p.moored_assets
@@ -406,7 +435,8 @@ def _berths(p: PortParams, plan: PortPlan, parts: list[TriMesh], *, rng: np.rand
             name, length, beam = fits[int(rng.integers(len(fits)))]
             yaw = float(np.pi / 2.0 if rng.uniform() < 0.5 else -np.pi / 2.0)
             bx = px + side * (p.pier_width_m / 2.0 + 3.0 + beam / 2.0)
-            cands.append(Berth(name, (bx, plan.quay_face - 5.0 - length / 2.0, yaw), (length, beam)))
+            face = (-side, 0.0)  # the pier lies on the other side of the ship
+            cands.append(Berth(name, (bx, plan.quay_face - 5.0 - length / 2.0, yaw), (length, beam), face))
     hulls = shapely.union_all([shapely.convex_hull(shapely.multipoints(m.vertices[:, :2])) for m in parts])
     chosen: list[Berth] = []
     taken: list[Polygon] = []
@@ -415,7 +445,10 @@ def _berths(p: PortParams, plan: PortPlan, parts: list[TriMesh], *, rng: np.rand
         fp = b.footprint()
         if fp.intersects(hulls) or any(fp.buffer(4.0).intersects(t) for t in taken):
             continue
-        chosen.append(b)
+        afloat = _afloat(b, p)
+        if afloat is None:
+            continue
+        chosen.append(afloat)
         taken.append(fp)
         if len(chosen) == p.n_moored:
             break
