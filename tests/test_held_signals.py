@@ -3,7 +3,9 @@ swallowed still ends every long loop at its next step (:func:`mmusv.held_signals
 generator's attempts, the batch's scenarios, the wave studies' settings, the detection study's frames, the
 training's steps (tests/learn/test_stops.py). The recording's and the converter's loops are checked end to end in
 tests/test_launch.py. Each test here swallows a stop in the middle of the loop (noted as the command's handler
-notes it, then not raised) and checks that no step ran after it; each fails where its loop does not look."""
+notes it, then not raised) and checks that no step ran after it; each fails where its loop does not look. An error
+a library made of the stop leaves a :func:`~mmusv.held_signals.stops_unwrapped` block as the stop (the recording,
+the conversion, a batch's task: end to end in tests/test_review_round9.py)."""
 
 from __future__ import annotations
 
@@ -14,7 +16,7 @@ from typing import Any
 
 import pytest
 import yaml
-from mmusv.held_signals import note_stop, raise_noted_stop
+from mmusv.held_signals import is_stop, note_stop, raise_noted_stop, stops_unwrapped
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -48,6 +50,27 @@ def test_no_stop_noted_raises_nothing_and_a_noted_one_raises_until_forgotten() -
         raise_noted_stop()
     note_stop(None)
     raise_noted_stop()
+
+
+def test_an_error_after_a_noted_stop_leaves_a_stops_unwrapped_block_as_the_stop() -> None:
+    # A library that met the stop's KeyboardInterrupt made an error of its own of it (Python 3.11's RuntimeError
+    # from __set_name__): the block's caller records the stop (interrupted), not a failure with that error.
+    wrapped = RuntimeError("Error calling __set_name__ on 'Field' instance")
+    with pytest.raises(RuntimeError), stops_unwrapped():  # no stop noted: errors leave as they are
+        raise wrapped
+    assert not is_stop(wrapped) and is_stop(KeyboardInterrupt())
+    note_stop(signal.SIGTERM)
+    assert is_stop(wrapped) and is_stop(KeyboardInterrupt()) and not is_stop(SystemExit(2))
+    with pytest.raises(KeyboardInterrupt) as stop, stops_unwrapped():
+        raise wrapped
+    assert stop.value.__cause__ is wrapped  # the library's error stays in the traceback
+    with pytest.raises(KeyboardInterrupt) as plain, stops_unwrapped():  # a plain stop leaves unchanged
+        raise KeyboardInterrupt
+    assert plain.value.__cause__ is None
+    with pytest.raises(SystemExit), stops_unwrapped():
+        raise SystemExit(2)
+    with stops_unwrapped():  # nothing raised: nothing raised (the loops' raise_noted_stop does that)
+        pass
 
 
 def test_the_generator_makes_no_attempt_after_a_swallowed_stop(tmp_path: Path, monkeypatch: Any) -> None:

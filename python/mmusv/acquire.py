@@ -36,7 +36,7 @@ from mmusv.annotate import annotate_agent
 from mmusv.config import Scenario, load_scenario, scenario_hash
 from mmusv.errors import ConfigError, IoError, MmusvError, located
 from mmusv.forking import check_polars
-from mmusv.held_signals import HeldSignals, raise_noted_stop
+from mmusv.held_signals import HeldSignals, raise_noted_stop, stops_unwrapped
 from mmusv.jsonio import dump_json, write_bytes_atomic
 from mmusv.profiling import RunProfile, clocks
 from mmusv.recording.background import BackgroundWriter
@@ -198,7 +198,9 @@ def run(
             writes there is taken by the wrong kind (a file named ``tables``, a folder named ``manifest.json``:
             refused before anything is written), or it cannot be written (the message names the cause, e.g.
             ``No space left on device``, and the frames that are safe).
-        KeyboardInterrupt: re-raised after the recording was finished with every completed frame.
+        KeyboardInterrupt: re-raised after the recording was finished with every completed frame (``status:
+            interrupted``); under the ``mmusv`` command also for an error a library made of the stop during a frame
+            (raised from that error: :func:`mmusv.held_signals.stops_unwrapped`).
     """
 
     from mmusv.batch.executors import refuse_in_worker_import
@@ -411,35 +413,38 @@ def _record(
         raise
     failure: BaseException | None = None
     try:
-        held.release()  # a stop held since the recording opened: KeyboardInterrupt here, inside the loop's handling
-        for k in range(first, total):
-            raise_noted_stop()  # a stop whose KeyboardInterrupt a library swallowed (held_signals)
-            tf = time.perf_counter()
-            if captured:  # frame `first`, captured before the recording was opened
-                cap, earlier = captured.pop()
-            else:
-                cap, earlier = sim.capture(k), 0.0
-            # The next frame's sea surface is sampled on its own thread while this one is annotated and written.
-            if k + 1 < total:
-                sim.prefetch_frame(k + 1, shading_detail=renders)
-            t1 = time.perf_counter()
-            item: _Frame | FrameCapture = cap if annotate_behind else annotate(cap)
-            t2 = time.perf_counter()
-            waited = writer.wait_seconds
-            writer.submit(item)  # (annotated and) written while the next frame is captured
-            if prof is not None:
-                prof.add("main:capture", t1 - tf + earlier)
-                for key, sec in cap.sensor_seconds.items():  # keyed <agent>/<sensor>: summed over the agents
-                    prof.add("main:capture/" + key.split("/", 1)[1], sec)
-                if not annotate_behind:
-                    prof.add("main:annotate", t2 - t1)
-                prof.add("main:wait", writer.wait_seconds - waited)
-            del cap, item
-            result.frame_seconds.append(time.perf_counter() - tf + earlier)
-            if progress is not None:
-                progress(k + 1 - first, total - first)
-        writer.close()
-        writer.raise_pending()
+        # an error a library made of the stop's KeyboardInterrupt leaves as the stop (held_signals): recorded as
+        # interrupted, as a plain Ctrl-C, not as failed with the library's error
+        with stops_unwrapped():
+            held.release()  # a stop held since the recording opened: KeyboardInterrupt here, in the loop's handling
+            for k in range(first, total):
+                raise_noted_stop()  # a stop whose KeyboardInterrupt a library swallowed (held_signals)
+                tf = time.perf_counter()
+                if captured:  # frame `first`, captured before the recording was opened
+                    cap, earlier = captured.pop()
+                else:
+                    cap, earlier = sim.capture(k), 0.0
+                # The next frame's sea surface is sampled on its own thread while this one is annotated and written.
+                if k + 1 < total:
+                    sim.prefetch_frame(k + 1, shading_detail=renders)
+                t1 = time.perf_counter()
+                item: _Frame | FrameCapture = cap if annotate_behind else annotate(cap)
+                t2 = time.perf_counter()
+                waited = writer.wait_seconds
+                writer.submit(item)  # (annotated and) written while the next frame is captured
+                if prof is not None:
+                    prof.add("main:capture", t1 - tf + earlier)
+                    for key, sec in cap.sensor_seconds.items():  # keyed <agent>/<sensor>: summed over the agents
+                        prof.add("main:capture/" + key.split("/", 1)[1], sec)
+                    if not annotate_behind:
+                        prof.add("main:annotate", t2 - t1)
+                    prof.add("main:wait", writer.wait_seconds - waited)
+                del cap, item
+                result.frame_seconds.append(time.perf_counter() - tf + earlier)
+                if progress is not None:
+                    progress(k + 1 - first, total - first)
+            writer.close()
+            writer.raise_pending()
     except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM through the command line's handler
         result.status = "interrupted"
         failure = exc

@@ -1,7 +1,10 @@
 """Holding SIGINT and SIGTERM back while steps run that a stop must not split (:class:`HeldSignals`): a
 recording opened and its metadata written (:mod:`mmusv.recording.guard`), the ``mmusv`` command's modules loaded
-(:mod:`mmusv._launch`). A module of its own, light to import: the command holds the signals before it loads the
-rest of mmusv.
+(:mod:`mmusv._launch`). And the stop the ``mmusv`` command's handler noted (:func:`note_stop`), for the work to
+end as a stop where a library met its ``KeyboardInterrupt``: raised again where the library swallowed it
+(:func:`raise_noted_stop`), and where the library made an error of its own of it, that error taken for the stop
+(:func:`is_stop`, :func:`stops_unwrapped`). A module of its own, light to import: the command holds the signals
+before it loads the rest of mmusv.
 """
 
 from __future__ import annotations
@@ -9,7 +12,7 @@ from __future__ import annotations
 from types import TracebackType
 from typing import Any
 
-__all__ = ["HeldSignals", "forget_handled_interrupt", "note_stop", "raise_noted_stop"]
+__all__ = ["HeldSignals", "forget_handled_interrupt", "is_stop", "note_stop", "raise_noted_stop", "stops_unwrapped"]
 
 _stop: list[int] = []
 """The stop the ``mmusv`` command's handler noted (at most one signal number; :func:`note_stop`)."""
@@ -102,7 +105,9 @@ def forget_handled_interrupt() -> None:
 
 def note_stop(signum: int | None) -> None:
     """Notes (or, with ``None``, forgets) the stop the ``mmusv`` command's signal handler received, before it
-    raises ``KeyboardInterrupt``: :func:`raise_noted_stop` raises it again where a library swallowed it."""
+    raises ``KeyboardInterrupt``: :func:`raise_noted_stop` raises it again where a library swallowed it, and
+    :func:`stops_unwrapped` where a library wrapped it in an error of its own. Only the command notes stops (its
+    handler, ``mmusv.cli``): called from Python, mmusv's functions see no noted stop and are unchanged."""
     _stop[:] = [] if signum is None else [signum]
 
 
@@ -116,3 +121,36 @@ def raise_noted_stop() -> None:
     models)."""
     if _stop:
         raise KeyboardInterrupt
+
+
+def is_stop(exc: BaseException) -> bool:
+    """Whether ``exc`` ends the work as a stop: a ``KeyboardInterrupt``, or an error raised after a stop was noted
+    (:func:`note_stop`), which a library made of the stop's ``KeyboardInterrupt`` (:func:`stops_unwrapped`)."""
+    return isinstance(exc, KeyboardInterrupt) or (bool(_stop) and isinstance(exc, Exception))
+
+
+class _StopsUnwrapped:
+    """The context manager of :func:`stops_unwrapped`."""
+
+    def __enter__(self) -> None:
+        return None
+
+    def __exit__(
+        self, exc_type: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
+    ) -> None:
+        if exc is not None and not isinstance(exc, KeyboardInterrupt) and is_stop(exc):
+            raise KeyboardInterrupt from exc
+
+
+def stops_unwrapped() -> _StopsUnwrapped:
+    """A ``with`` block in which an error raised after a stop was noted (:func:`note_stop`) leaves as that stop, a
+    ``KeyboardInterrupt`` raised from the error (:func:`is_stop`); without a noted stop errors leave unchanged, and
+    nothing is raised where the block raised nothing (:func:`raise_noted_stop` does that, once a step). A library
+    that meets the stop's ``KeyboardInterrupt`` may wrap it in an error of its own (Python 3.11's ``RuntimeError``
+    from ``__set_name__`` while a lazy import defines a dataclass, pydantic-core's ``SchemaError``), which was
+    recorded as ``failed`` with that error under a command that said ``mmusv: interrupted``. The recording's frames
+    (``mmusv.acquire``), a conversion (``mmusv.export.conversion``; its writer stops as for a Ctrl-C: ``is_stop``)
+    and a batch's task run in the command's process (``mmusv.batch.task``) run in one: the error is recorded as the
+    stop it is (``status: interrupted``, as for a plain Ctrl-C). The command itself ends any error after a stop as
+    the stop (``mmusv.cli``)."""
+    return _StopsUnwrapped()

@@ -4,7 +4,8 @@
 worker of a killed run is still writing: it waits until that worker is gone), appends one line for this attempt
 (the driver's run id: the lines of this run count the attempts, a worker lost and retried included), removes the
 old ``manifest.json``, runs :func:`mmusv.acquire.run` and empties the file again once the recording is complete.
-It never raises for a failure of the scenario: everything comes back as a :class:`TaskResult`.
+It never raises for a failure of the scenario: everything comes back as a :class:`TaskResult`. A stop raises
+``KeyboardInterrupt``, also where a library made an error of its own of it (:func:`mmusv.held_signals.stops_unwrapped`).
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from types import TracebackType
 
 from mmusv.batch.plan import Task
 from mmusv.errors import InternalError, IoError, MmusvError
+from mmusv.held_signals import stops_unwrapped
 
 __all__ = ["LOCK_TIMEOUT_S", "TaskResult", "execute", "lost"]
 
@@ -108,14 +110,17 @@ class _TaskState:
 
 
 def execute(task: Task) -> TaskResult:
-    """Runs ``task`` (see the module docstring); returns its result, never raises but ``KeyboardInterrupt``."""
+    """Runs ``task`` (see the module docstring); returns its result, never raises but ``KeyboardInterrupt`` (a stop,
+    or an error a library made of one)."""
     from mmusv.acquire import run
     from mmusv.run_folder import refuse_foreign_files
 
     t0 = time.perf_counter()
     res = TaskResult(key=task.key, status="failed", pid=os.getpid(), threads=os.environ.get("RAYON_NUM_THREADS"))
     try:
-        with _TaskState(Path(task.state_file), task.run_id) as state:
+        # an error a library made of a stop of the command's (a task run in the driver, serially) leaves as the
+        # stop (held_signals): the batch ends as stopped, not with the scenario failed by the library's error
+        with _TaskState(Path(task.state_file), task.run_id) as state, stops_unwrapped():
             res.attempts = state.attempts
             # a manifest.json (or scenario.yaml) no run wrote is refused before the task's own manifest goes: the
             # plan checked (batch.plan), but a user may have put one there since

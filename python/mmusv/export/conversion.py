@@ -58,7 +58,7 @@ from mmusv.export.convert_report import REPORT_NAME, ConvertReport, RecordingRep
 from mmusv.export.convert_report import load_report as load_report  # importable from here as before
 from mmusv.export.splits import DEFAULT_RATIOS, SPLIT_NAMES, assign_splits, parse_ratios
 from mmusv.export.writer import DatasetWriter
-from mmusv.held_signals import raise_noted_stop
+from mmusv.held_signals import is_stop, raise_noted_stop, stops_unwrapped
 from mmusv.recording.info import RecordingInfo, read_info
 from mmusv.recording.stream import FrameStream, held_text
 from mmusv.text import counted, given, named
@@ -364,7 +364,9 @@ def convert(
                 **({"oxts_origin": list(origin)} if origin is not None else {}),
             },
         }
-        with staged(work, out), reported(work / REPORT_NAME, header), _write_failures(out):
+        # an error a library made of a stop's KeyboardInterrupt leaves as the stop (held_signals): conversion.yaml
+        # says interrupted, as for a plain Ctrl-C, not failed with the library's error
+        with staged(work, out), reported(work / REPORT_NAME, header), _write_failures(out), stops_unwrapped():
             sink = Sink()
             shared = cls.start(work, options, sink)
             report = ConvertReport(out_dir=out, target=to, recordings=reports)
@@ -461,7 +463,7 @@ def convert(
                     writer.finish(sorted(converted), rep.skipped)
                 except BaseException as exc:  # a stop, or an error: a file the writer holds open is closed
                     with contextlib.suppress(Exception):
-                        writer.stop(interrupted=isinstance(exc, KeyboardInterrupt))
+                        writer.stop(interrupted=is_stop(exc))  # (an error a library made of a stop: the stop)
                     raise
                 rep.notes += writer.notes
                 rep.frames_converted = len(converted)
