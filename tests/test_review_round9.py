@@ -4,19 +4,22 @@ convert`` and a serial batch (``mmusv run FOLDER``) that the command's signal ha
 (``held_signals.note_stop``/``raise_noted_stop``, ``cli._run_command``) did not end as a stop: one a library wraps
 in an error of its own during a frame (or as a batch's task loads its scenario) was recorded as ``failed`` with that
 error (manifest.json, the recording's run metadata, conversion.yaml, the batch's scenario) while the command said
-``interrupted`` (now ``held_signals.stops_unwrapped``); one a library swallows in the last frame (after the loop's
-last ``raise_noted_stop``) exits 130 with nothing on stderr, marked ``xfail`` (it needs ``cli.py``)."""
+``interrupted`` (now ``held_signals.stops_unwrapped``), and one a library swallows in the last frame (after the
+loop's last ``raise_noted_stop``) exited 130 with nothing on stderr (now ``cli._run_command`` says the stop)."""
 
 from __future__ import annotations
 
 import importlib
 import json
+import signal
 import subprocess
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
 import yaml
+from mmusv.errors import ConfigError
 
 # A scenario of four frames that records in a second: one USV with a LiDAR, one target, open sea.
 _TINY = {
@@ -105,17 +108,11 @@ def test_a_stop_wrapped_by_a_library_in_a_frame_is_recorded_as_interrupted(tmp_p
     assert 0 < int(manifest["frames_written"]) <= 2, manifest  # the frames before the stop (frame 1 may be whole)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="a stop a library swallows in the last frame (after the loop's last raise_noted_stop) is never raised "
-    "again: `mmusv run` prints its success line and exits 130 with nothing on stderr, not 'mmusv: interrupted' as "
-    "every other stop (a stop held while the run finishes ends so, acquire._record); needs acquire.py or cli.py",
-)
 def test_a_stop_swallowed_in_the_last_frame_still_ends_in_the_one_line(tmp_path: Path) -> None:
     done, manifest = _run_stopped(tmp_path, at=3, how="swallow")
     assert manifest["status"] == "complete"  # every frame was captured: the recording is whole
     assert done.returncode == 130
-    assert done.stderr == "mmusv: interrupted\n", done.stderr  # it is empty
+    assert done.stderr == "mmusv: interrupted\n", done.stderr  # it was empty
 
 
 # `mmusv convert` of a recording of the tiny scenario whose frame stream, once frame AT was converted, sends the
@@ -172,6 +169,14 @@ def test_a_stop_wrapped_by_a_library_in_a_conversion_frame_is_recorded_as_interr
         assert bag["rosbag2_bagfile_information"]["custom_data"]["mmusv.status"] == "interrupted"
 
 
+def test_a_stop_swallowed_in_a_conversion_s_last_frame_still_ends_in_the_one_line(tmp_path: Path) -> None:
+    # every command, not only `mmusv run`: the conversion is whole ("complete"), the command ends as a stop
+    done, report = _convert_stopped(tmp_path, to="kitti", at=3, how="swallow")
+    assert report["status"] == "complete" and report["frames_converted"] == 4, report
+    assert done.returncode == 130
+    assert done.stderr == "mmusv: interrupted\n", done.stderr  # it was empty
+
+
 # `mmusv run FOLDER` (a serial batch: the tasks run in the command's process) of the tiny scenario, whose capture of
 # frame 1 ("frame") or whose task's loading of the scenario ("load") sends the process SIGINT and lets a "library"
 # wrap the KeyboardInterrupt in an error of its own.
@@ -222,3 +227,43 @@ def test_a_stop_wrapped_by_a_library_in_a_serial_batch_stops_the_batch(tmp_path:
         assert json.loads(manifest.read_text(encoding="utf-8"))["status"] == "interrupted"
     else:  # stopped before its recording was opened: nothing of it written
         assert not manifest.exists()
+
+
+def _swallowing_command(signum: int, *, then: Exception | None) -> Callable[[object], int]:
+    """A command (``cli._dispatch``) in which a library swallows the stop ``signum`` brings, then that ends with
+    ``then`` raised, or returns 0."""
+    import os
+    import time
+
+    def command(args: object) -> int:
+        try:
+            os.kill(os.getpid(), signum)
+            time.sleep(5)
+        except KeyboardInterrupt:
+            pass  # swallowed
+        if then is not None:
+            raise then
+        return 0
+
+    return command
+
+
+@pytest.mark.parametrize(
+    ("signum", "then", "said"),
+    [
+        (signal.SIGINT, None, ["mmusv: interrupted"]),
+        (signal.SIGTERM, None, ["mmusv: terminated (SIGTERM)"]),
+        (signal.SIGINT, ConfigError("bad"), ["mmusv: error: bad", "mmusv: interrupted"]),
+    ],
+)
+def test_every_command_ends_a_stop_it_did_not_end_on_with_the_one_line(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str], signum: int, then: Exception | None,
+    said: list[str],
+) -> None:  # fmt: skip
+    # Said by the command line after any command (cli._run_command), not by each command's loops: the command's own
+    # error, if it said one, goes first.
+    import mmusv.cli as cli
+
+    monkeypatch.setattr(cli, "_dispatch", _swallowing_command(signum, then=then))
+    assert cli.main(["version"]) == 128 + signum
+    assert capsys.readouterr().err.splitlines() == said

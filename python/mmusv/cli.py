@@ -35,13 +35,16 @@ from mmusv.held_signals import forget_handled_interrupt, note_stop
 class _Signals:
     """While a command runs: SIGTERM (a ``kill``, a service manager) and SIGINT (Ctrl-C) both end it the way
     Ctrl-C always did — raised as ``KeyboardInterrupt`` in the main thread, so the current frame is finished or
-    abandoned, files are closed and background jobs are stopped — and the exit status is 128 + the signal's
-    number. The previous handlers come back afterwards (``main`` may be called in-process)."""
+    abandoned, files are closed and background jobs are stopped — and the command ends with one line, ``mmusv:
+    interrupted`` (``mmusv: terminated (SIGTERM)``), and the exit status 128 + the signal's number: also where a
+    library swallowed the ``KeyboardInterrupt`` in the command's last step or made an error of its own of it. The
+    previous handlers come back afterwards (``main`` may be called in-process)."""
 
     SIGNALS = ("SIGINT", "SIGTERM")
 
     def __init__(self) -> None:
         self.received: int | None = None
+        self.said = False  # the command's stop was said (:func:`_stopped`)
         self._old: dict[int, object] = {}
         self._hook: Callable[[Any], object] = sys.unraisablehook
 
@@ -155,16 +158,22 @@ def _run_command(args: argparse.Namespace) -> int:
             if signals.received is None:
                 raise
             code = _stopped(signals)
+        if signals.received is not None and not signals.said:
+            # A stop the command did not end on: its KeyboardInterrupt was swallowed after the last step's
+            # raise_noted_stop (a library's, in a recording's last frame: the run finished whole, "complete"), or
+            # the command said an error of its own meanwhile. Every stop ends with the one line and 128 + signal.
+            code = _stopped(signals)
     if signals.received is not None:  # the command ends with its own status, not CPython's for an interrupt
         forget_handled_interrupt()
     return signals.status(code)
 
 
 def _stopped(signals: _Signals) -> int:
-    """Says that the command was stopped (``mmusv: interrupted``, or ``terminated (SIGTERM)``); returns 130, which
-    :meth:`_Signals.status` makes 128 + the signal received."""
+    """Says that the command was stopped (``mmusv: interrupted``, or ``terminated (SIGTERM)``), once; returns 130,
+    which :meth:`_Signals.status` makes 128 + the signal received."""
     name = "terminated (SIGTERM)" if signals.received not in (None, 2) else "interrupted"
     cli_console.say(f"mmusv: {name}")
+    signals.said = True
     return 130
 
 
