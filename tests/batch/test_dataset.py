@@ -84,6 +84,23 @@ def test_an_unfinished_dataset_is_finished(built: tuple[Path, Path, str], tmp_pa
     assert stamps(out / "recordings", others) == keep and tree(out) == tree(done)
 
 
+def test_a_combination_added_before_the_others_records_only_its_own(
+    built: tuple[Path, Path, str], tmp_path: Path
+) -> None:
+    """A combination put first in the spec: the draws were keyed by the combinations' places in the list, so every
+    scenario changed and the whole dataset was recorded again; they are keyed by name, so only the new one is."""
+    _spec, done, _ = built
+    out = tmp_path / "ds"
+    shutil.copytree(done, out)
+    names = [p.name for p in (out / "recordings").iterdir() if p.is_dir() and not p.name.startswith(".")]
+    keep = stamps(out / "recordings", names)
+    added = {"family": "overtaking", "difficulty": "near", "cooperating": 1, "targets": ["small"], "quota": 1}
+    edited = write(tmp_path / "tinyset.yaml", dict(SPEC, combinations=[added, *SPEC["combinations"]]))
+    rep = build_dataset(edited, out_dir=out)
+    assert rep.generated and rep.batch.summary() == "1 done, 0 failed, 3 skipped, 0 retried"
+    assert stamps(out / "recordings", names) == keep
+
+
 def test_a_sequence_removed_by_hand_is_converted_again(built: tuple[Path, Path, str], tmp_path: Path) -> None:
     """A converted sequence's folder removed by hand (``conversion.yaml`` still says complete): the re-run said
     "opv2v: ... is up to date" and left it missing; it converts again, into the same bytes, the recordings kept."""
