@@ -1,10 +1,10 @@
 """Holding SIGINT and SIGTERM back while steps run that a stop must not split (:class:`HeldSignals`): a
 recording opened and its metadata written (:mod:`mmusv.recording.guard`), the ``mmusv`` command's modules loaded
-(:mod:`mmusv._launch`). And the stop the ``mmusv`` command's handler noted (:func:`note_stop`), for the work to
-end as a stop where a library met its ``KeyboardInterrupt``: raised again where the library swallowed it
-(:func:`raise_noted_stop`), and where the library made an error of its own of it, that error taken for the stop
-(:func:`is_stop`, :func:`stops_unwrapped`). A module of its own, light to import: the command holds the signals
-before it loads the rest of mmusv.
+(:mod:`mmusv._launch`). And the stop the ``mmusv`` command's handler (or its batch's pool worker's) noted
+(:func:`note_stop`), for the work to end as a stop where a library met its ``KeyboardInterrupt``: raised again
+where the library swallowed it (:func:`raise_noted_stop`), and where the library made an error of its own of it,
+that error taken for the stop (:func:`is_stop`, :func:`stops_unwrapped`). A module of its own, light to import:
+the command holds the signals before it loads the rest of mmusv.
 """
 
 from __future__ import annotations
@@ -107,7 +107,8 @@ def note_stop(signum: int | None) -> None:
     """Notes (or, with ``None``, forgets) the stop the ``mmusv`` command's signal handler received, before it
     raises ``KeyboardInterrupt``: :func:`raise_noted_stop` raises it again where a library swallowed it, and
     :func:`stops_unwrapped` where a library wrapped it in an error of its own. Only the command notes stops (its
-    handler, ``mmusv.cli``): called from Python, mmusv's functions see no noted stop and are unchanged."""
+    handler, ``mmusv.cli``, and that of its batch's pool workers, ``mmusv.batch.executors``): called from Python,
+    mmusv's functions see no noted stop and are unchanged."""
     _stop[:] = [] if signum is None else [signum]
 
 
@@ -117,9 +118,10 @@ def raise_noted_stop() -> None:
     inside importlib's module-lock callback, which Python reports as "Exception ignored" and goes on: the run went
     on to its last frame (1 of 200 starts of ``mmusv run`` under load). Every long loop calls this once a step: the
     recording's and the converter's frames, the generator's attempts, the batch's finished scenarios, the wave
-    studies' settings, the detection study's frames (and its jobs' results), the training's steps (and its jobs'
-    models). A stop swallowed in a loop's last step, after its last call, is said by the command once it returns
-    (``mmusv: interrupted``, status 128 + the signal: ``mmusv.cli``); the work itself was done whole."""
+    studies' settings, the agreement study's frames, the detection study's frames (and its jobs' results), the
+    training's steps (and its jobs' models). A stop swallowed in a loop's last step, after its last call, is said
+    by the command once it returns (``mmusv: interrupted``, status 128 + the signal: ``mmusv.cli``); the work
+    itself was done whole."""
     if _stop:
         raise KeyboardInterrupt
 
@@ -151,7 +153,7 @@ def stops_unwrapped() -> _StopsUnwrapped:
     from ``__set_name__`` while a lazy import defines a dataclass, pydantic-core's ``SchemaError``), which was
     recorded as ``failed`` with that error under a command that said ``mmusv: interrupted``. The recording's frames
     (``mmusv.acquire``), a conversion (``mmusv.export.conversion``; its writer stops as for a Ctrl-C: ``is_stop``)
-    and a batch's task run in the command's process (``mmusv.batch.task``) run in one: the error is recorded as the
-    stop it is (``status: interrupted``, as for a plain Ctrl-C). The command itself ends any error after a stop as
-    the stop (``mmusv.cli``)."""
+    and a batch's task (``mmusv.batch.task``, in the command's process or a pool worker) run in one: the error is
+    recorded as the stop it is (``status: interrupted``, as for a plain Ctrl-C). The command itself ends any error
+    after a stop as the stop (``mmusv.cli``)."""
     return _StopsUnwrapped()

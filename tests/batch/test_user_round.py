@@ -186,15 +186,20 @@ def test_a_second_stop_signal_does_not_interrupt_the_recordings_clean_up(monkeyp
     """A pool worker's first SIGINT/SIGTERM stops its recording (KeyboardInterrupt); the next, while it finishes the
     recording as interrupted (a Ctrl-C reaches every worker, and the driver SIGTERMs them right after), raised
     again inside that clean-up."""
+    from mmusv.held_signals import note_stop
+
     monkeypatch.setattr(batch_executors, "_IN_TASK", True)
     monkeypatch.setattr(batch_executors, "_STOPPING", False)
-    with pytest.raises(KeyboardInterrupt):
-        batch_executors._stop(signal.SIGINT, None)
     try:
-        batch_executors._stop(signal.SIGTERM, None)  # ignored: the task is finishing
-    except KeyboardInterrupt:
-        pytest.fail("a second signal interrupted the task again, inside its clean-up")
-    assert batch_executors._STOPPING
+        with pytest.raises(KeyboardInterrupt):
+            batch_executors._stop(signal.SIGINT, None)
+        try:
+            batch_executors._stop(signal.SIGTERM, None)  # ignored: the task is finishing
+        except KeyboardInterrupt:
+            pytest.fail("a second signal interrupted the task again, inside its clean-up")
+        assert batch_executors._STOPPING
+    finally:  # the worker's handler notes its stop (held_signals): not left noted for the tests after this one
+        note_stop(None)
 
 
 @pytest.mark.slow

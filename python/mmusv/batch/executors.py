@@ -22,6 +22,7 @@ from typing import Any, Protocol
 
 from mmusv.batch.plan import Task
 from mmusv.batch.task import TaskResult, execute, lost
+from mmusv.held_signals import note_stop
 
 __all__ = [
     "Executor",
@@ -229,12 +230,18 @@ def _stop(signum: int, frame: object) -> None:
     A further signal while that task finishes its recording is ignored: a Ctrl-C reaches the driver and every
     worker at once, and the driver's :func:`_reap` sends SIGTERM right after, so a second ``KeyboardInterrupt``
     raised inside the first one's clean-up left the recording a ``.partial`` without its manifest (and, in a
-    finaliser, printed a traceback)."""
+    finaliser, printed a traceback). The stop is noted (:func:`mmusv.held_signals.note_stop`), as the command's
+    handler notes its own: where a library swallows that ``KeyboardInterrupt`` the recording's next frame raises it
+    again, and where a library wraps it in an error of its own the recording says interrupted, not failed."""
     global _STOPPING
     first = not _STOPPING
     _STOPPING = True
     if _IN_TASK:
         if first:
+            # noted as the command's handler notes its stop: one a library swallows in a frame is raised again at
+            # the next (it recorded on, ignoring the reaper's SIGTERMs, until killed: a .partial without manifest),
+            # and one it wraps in an error of its own is recorded as interrupted, not failed (held_signals)
+            note_stop(signum)
             raise KeyboardInterrupt
         return
     os._exit(128 + signum)

@@ -118,8 +118,8 @@ def execute(task: Task) -> TaskResult:
     t0 = time.perf_counter()
     res = TaskResult(key=task.key, status="failed", pid=os.getpid(), threads=os.environ.get("RAYON_NUM_THREADS"))
     try:
-        # an error a library made of a stop of the command's (a task run in the driver, serially) leaves as the
-        # stop (held_signals): the batch ends as stopped, not with the scenario failed by the library's error
+        # an error a library made of a noted stop (the command's, serially; a pool worker's) leaves as the stop
+        # (held_signals): the batch ends as stopped, not with the scenario failed by the library's error
         with _TaskState(Path(task.state_file), task.run_id) as state, stops_unwrapped():
             res.attempts = state.attempts
             # a manifest.json (or scenario.yaml) no run wrote is refused before the task's own manifest goes: the

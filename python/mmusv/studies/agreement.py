@@ -46,6 +46,7 @@ from mmusv.config import Scenario, load_scenario
 from mmusv.errors import ConfigError, located
 from mmusv.forking import check_polars
 from mmusv.frames import translation
+from mmusv.held_signals import raise_noted_stop
 from mmusv.jsonio import write_files_atomic
 from mmusv.sensors.config import RigConfig
 from mmusv.simulation import Simulation
@@ -224,6 +225,7 @@ def run_agreement_study(
         sim = Simulation(sc)
         n = sc.acquisition.frames if frames is None else min(frames, sc.acquisition.frames)
         for k in range(0, n, stride):
+            raise_noted_stop()  # a stop whose KeyboardInterrupt a library swallowed (held_signals)
             cap = sim.capture(k, sensors=["top_view"])
             state = cap.world
             for agent in sim.agents:
