@@ -12,6 +12,10 @@ Two loops still went on past a swallowed stop:
   ``.partial`` with no manifest), and one a library wrapped in an error of its own was recorded ``failed`` with that
   error, as 298477f fixed for the serial batch only.
 
+And a stop of ``mmusv study detection --jobs N`` (45e86dd raises a swallowed one after each wait; a plain SIGTERM
+lands there too) left the loop inside ``with ProcessPoolExecutor``, whose exit waits for every sequence submitted:
+the study ran all of them before it ended as stopped (:func:`mmusv.studies.detection.parallel._stop_jobs`).
+
 The rest was checked apart from the code under test and found as described (see the report of this round): the
 waterplane weights against a plane fitted over the disc to a single plane wave in any direction, the phase against
 ``WaveField.elevation``; the replacement ship inside its berth's footprint and touching the same face, quay and pier.
@@ -128,3 +132,51 @@ def test_a_stop_wrapped_by_a_library_in_a_pool_worker_s_frame_is_recorded_as_int
     manifest = _record_with_a_worker_stop(tmp_path, monkeypatch, how="wrap")
     assert manifest["status"] == "interrupted", manifest
     assert "RuntimeError" not in json.dumps(manifest), manifest
+
+
+class _SlowSequences:
+    """A stand-in for :class:`mmusv.studies.detection.sources.Dataset` (pickled to the study's worker processes):
+    each sequence's load leaves a file named after it in ``folder``, waits ``seconds`` and fails as bad input."""
+
+    def __init__(self, folder: str, names: list[str], seconds: float) -> None:
+        self.folder, self.seconds = folder, seconds
+        self.sources = {n: Path(folder) / n for n in names}
+
+    def frames_by_sequence(self) -> dict[str, int]:
+        return dict.fromkeys(self.sources, 1)
+
+    def load(self, name: str) -> Any:
+        import time
+
+        from mmusv.errors import InputError
+
+        (Path(self.folder) / name).touch()
+        time.sleep(self.seconds)
+        raise InputError(f"{name}: not a sequence (a stand-in)")
+
+
+def test_a_stop_of_the_detection_study_s_jobs_runs_no_further_sequence(tmp_path: Path, monkeypatch: Any) -> None:
+    # `mmusv study detection --jobs N` over more sequences than processes: a stop (here a swallowed one, noted and
+    # raised again after the first sequence's result, as 45e86dd does; a plain SIGTERM raises at the same place)
+    # left the loop inside `with ProcessPoolExecutor`, whose exit waits for every sequence submitted: the study
+    # ran all of them (hours on a large dataset) before it ended as stopped.
+    import signal
+
+    import mmusv.studies.detection.parallel as parallel
+    from mmusv.studies.detection.study import StudyOptions
+
+    names = [f"s{k}" for k in range(6)]
+    original = parallel.wait
+
+    def wait(*args: Any, **kwargs: Any) -> Any:
+        done = original(*args, **kwargs)
+        note_stop(signal.SIGINT)  # the stop's KeyboardInterrupt was swallowed meanwhile
+        return done
+
+    monkeypatch.setattr(parallel, "wait", wait)
+    dataset = _SlowSequences(str(tmp_path), names, seconds=0.5)
+    with pytest.raises(KeyboardInterrupt):
+        parallel.run_study_jobs(dataset, options=StudyOptions(), spec=parallel.DetectorSpec(), jobs=1)  # type: ignore[arg-type]
+    loaded = sorted(p.name for p in tmp_path.iterdir())
+    # the first, and at most the one the pool had already handed its process: not the other four
+    assert len(loaded) <= 2, loaded

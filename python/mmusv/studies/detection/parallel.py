@@ -96,6 +96,23 @@ def _run_task(dataset: Dataset, name: str, options: StudyOptions, spec: Detector
         return "error", str(exc), []
 
 
+def _stop_jobs(pool: ProcessPoolExecutor) -> None:
+    """Ends the jobs of ``pool`` when the study ends early (a stop: Ctrl-C, SIGTERM, or a swallowed stop raised
+    again; or a sequence's error): the sequences not started are cancelled and the running ones' processes ended
+    (they write nothing; their results would be dropped). Leaving the ``with`` block alone waited for every sequence
+    submitted: a stop of ``--jobs 1`` over six sequences ran all six before it ended."""
+    # the pool has no public handle on its processes, and forgets them when shut down
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for proc in processes:
+        proc.terminate()
+    for proc in processes:
+        proc.join(5.0)
+        if proc.is_alive():
+            proc.kill()
+            proc.join(1.0)
+
+
 def run_study_jobs(
     dataset: Dataset,
     *,
@@ -123,20 +140,22 @@ def run_study_jobs(
             pending: dict[Future[tuple[str, Any, list[int]]], str] = {
                 pool.submit(_task, dataset, n, bare, spec, flags()): n for n in names
             }
-        while pending:
-            finished, _ = wait(pending, return_when=FIRST_COMPLETED)
-            raise_noted_stop()  # a stop whose KeyboardInterrupt a library swallowed (held_signals)
-            for fut in finished:
-                name = pending.pop(fut)
-                status, value, nbytes = fut.result()
-                if status == "error":
-                    for other in pending:
-                        other.cancel()
-                    raise InputError(value)
-                parts[name], shared[name] = value, nbytes
-                done += frames.get(name, 0)
-                if progress is not None:
-                    progress(done, total)
+        try:
+            while pending:
+                finished, _ = wait(pending, return_when=FIRST_COMPLETED)
+                raise_noted_stop()  # a stop whose KeyboardInterrupt a library swallowed (held_signals)
+                for fut in finished:
+                    name = pending.pop(fut)
+                    status, value, nbytes = fut.result()
+                    if status == "error":
+                        raise InputError(value)
+                    parts[name], shared[name] = value, nbytes
+                    done += frames.get(name, 0)
+                    if progress is not None:
+                        progress(done, total)
+        except BaseException:  # a stop, or a sequence's error: the pool's exit waited for every sequence submitted
+            _stop_jobs(pool)
+            raise
     res = StudyResult.merge(options, [parts[n] for n in names])
     check_predictions_used(res)
     return res, [b for n in names for b in shared[n]]
