@@ -1,11 +1,13 @@
 """Review of d2da72c..d888fe0: the stops a library swallows or wraps (``held_signals``), the name-keyed draws of
 ``mmusv generate``, the buoys on their waterplane, the moored ships that float.
 
-Two loops still went on past a swallowed stop:
+Three loops still went on past a swallowed stop:
 
 * ``mmusv study agreement`` (:func:`mmusv.studies.agreement.run_agreement_study`) captures every frame of every
   scenario, minutes of work, with no ``raise_noted_stop``: a stop whose ``KeyboardInterrupt`` a library swallowed
   ran the study to its end (45e86dd's "every long loop" left it out).
+* ``mmusv train``'s cache (:func:`mmusv.learn.cache.build_cache`) loads every sequence of the dataset before the
+  first training step, with no ``raise_noted_stop``: a stop swallowed while one loaded loaded all the others.
 * a pool worker's handler (:func:`mmusv.batch.executors._stop`, SIGTERM/SIGINT in a ``--jobs N`` worker) raised
   ``KeyboardInterrupt`` without noting the stop: one a library swallowed in a frame was never raised again (the
   worker recorded on, ignoring the driver's further SIGTERMs, until it was killed after ``_REAP_S``, leaving a
@@ -180,3 +182,27 @@ def test_a_stop_of_the_detection_study_s_jobs_runs_no_further_sequence(tmp_path:
     loaded = sorted(p.name for p in tmp_path.iterdir())
     # the first, and at most the one the pool had already handed its process: not the other four
     assert len(loaded) <= 2, loaded
+
+
+def test_the_training_cache_loads_no_sequence_after_a_swallowed_stop(tmp_path: Path, monkeypatch: Any) -> None:
+    # `mmusv train` packs its dataset into a cache first, loading each sequence when reached (minutes for a large
+    # dataset): a stop swallowed while the first loaded went on to load every other one before the training's
+    # steps raised it.
+    import mmusv.learn.cache as cache
+    import mmusv.studies.detection.sources as sources
+
+    loaded: list[str] = []
+
+    class Sequences:
+        def sequences(self) -> Iterator[Any]:
+            for name in ("a", "b", "c", "d"):
+                loaded.append(name)
+                if name == "a":
+                    note_stop(signal.SIGINT)  # ... and the KeyboardInterrupt raised after it was swallowed
+                yield SimpleNamespace(name=name, frames=[], agent_ids=[])
+
+    monkeypatch.setattr(sources, "resolve_dataset", lambda *args, **kwargs: Sequences())
+    monkeypatch.setattr(cache, "dataset_fingerprints", lambda ds: {})
+    with pytest.raises(KeyboardInterrupt):  # before: all four loaded, then "no frame to cache" (an InputError)
+        cache.build_cache([], tmp_path / "cache.npz")
+    assert loaded == ["a"]

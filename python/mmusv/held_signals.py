@@ -119,9 +119,9 @@ def raise_noted_stop() -> None:
     on to its last frame (1 of 200 starts of ``mmusv run`` under load). Every long loop calls this once a step: the
     recording's and the converter's frames, the generator's attempts, the batch's finished scenarios, the wave
     studies' settings, the agreement study's frames, the detection study's frames (and its jobs' results), the
-    training's steps (and its jobs' models). A stop swallowed in a loop's last step, after its last call, is said
-    by the command once it returns (``mmusv: interrupted``, status 128 + the signal: ``mmusv.cli``); the work
-    itself was done whole."""
+    training cache's sequences, the training's steps (and its jobs' models). A stop swallowed in a loop's last
+    step, after its last call, is said by the command once it returns (``mmusv: interrupted``, status 128 + the
+    signal: ``mmusv.cli``); the work itself was done whole."""
     if _stop:
         raise KeyboardInterrupt
 

@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from mmusv.held_signals import raise_noted_stop
 from mmusv.learn._errors import input_error
 from mmusv.text import given
 
@@ -131,7 +132,8 @@ def build_cache(
     names: list[str] = []
     sample_cloud: list[int] = []
     gts: list[np.ndarray] = []
-    for s, seq in enumerate(ds.sequences()):
+    for s, seq in enumerate(ds.sequences()):  # each loaded when reached: minutes for a large dataset
+        raise_noted_stop()  # a stop whose KeyboardInterrupt a library swallowed (held_signals)
         if seq.frames and not seq.agent_ids:  # it left no sample, and the cache was built (or "no frame to cache")
             raise input_error(
                 f"sequence {seq.name}: no LiDAR: none of its instrumented USVs carries one (a rig with lidar: null), "
