@@ -557,3 +557,14 @@ def test_a_basin_deep_enough_moors_the_large_ship_where_it_was_drawn() -> None:
     (instead,) = [(a, pose) for a, pose in shallow.moored if abs(pose[0] - big[0]) < 1e-6 and a != "pilot_boat_16m"]
     assert instead[0] == "feeder_container_140m"
     assert abs(abs(instead[1][1] - big[1]) - (48.2 - 22.5) / 2) < 1e-6
+
+
+def test_a_moored_ship_a_user_gives_that_would_ground_is_refused_naming_the_basin() -> None:
+    # Given by a user, an entry whose draft reaches the basin's floor left its berths to others (or the port empty)
+    # without a word; the default list keeps its large ship for deep basins and gives way in shallow ones.
+    with pytest.raises(MapConfigError, match=r"entry 1 \('container_ship_300m'\): its draft, 14\.5 m, reaches"):
+        make_params("port", moored_assets=[["tug_32m", 32, 12], ["container_ship_300m", 300, 48.2]])
+    with pytest.raises(MapConfigError, match=r"basin_depth_m = 7 m"):
+        make_params("port", basin_depth_m=7, moored_assets=[["feeder_container_140m", 140, 22.5]])
+    assert make_params("port", basin_depth_m=16, moored_assets=[["container_ship_300m", 300, 48.2]])
+    assert make_params("port", basin_depth_m=7)  # the default list: the ships that float are moored

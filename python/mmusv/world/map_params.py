@@ -353,6 +353,8 @@ class PortParams(_CommonParams):
             except AssetNameError as exc:  # said with the entry, as a vessel's asset is: not only when built
                 raise ValueError(f"entry {k} ({name!r}): {exc}") from None
         _berths_hold_their_ships(v)
+        if v != DEFAULT_MOORED_ASSETS and "basin_depth_m" in info.data:
+            _ships_float(v, info.data["basin_depth_m"])
         return v
 
 
@@ -380,6 +382,25 @@ def _berths_hold_their_ships(entries: tuple[_Berth, ...]) -> None:
                 f"{ship.length:g} x {ship.beam:g} m: the port lays the berth out for the size given, so a ship more "
                 f"than {MOORED_SIZE_SLACK_M:g} m longer or broader than it lies in the quay, a pier or the next ship; "
                 f"give the ship's own figures [{name}, {ship.length:g}, {ship.beam:g}] (or larger, for more room)"
+            )
+
+
+def _ships_float(entries: tuple[_Berth, ...], basin_depth_m: float) -> None:
+    """A ``ValueError`` naming the first entry of a ``moored_assets`` a user gave whose ship's draft (its hull
+    particulars, as the ``under_keel`` check reads them) reaches ``basin_depth_m``: the port moors no ship that would
+    ground, so such an entry would leave its berths to others, or the port empty, without a word. The default list
+    is not refused: the 300 m container ship in it gives way to the longest ship that floats where the basin is too
+    shallow for it (:mod:`mmusv.world.port`)."""
+    from mmusv.world.hydrostatics import hull_particulars
+    from mmusv.world.vessels import get_asset
+
+    for k, (name, _length, _beam) in enumerate(entries):
+        draft = hull_particulars(get_asset(name))[2]
+        if draft >= basin_depth_m:
+            raise ValueError(
+                f"entry {k} ({name!r}): its draft, {draft:g} m, reaches the basin's floor (basin_depth_m = "
+                f"{basin_depth_m:g} m), so it would ground at its berth and is never moored; set basin_depth_m "
+                f"above {draft:g} or leave the entry out"
             )
 
 
