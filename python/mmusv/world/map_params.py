@@ -258,9 +258,10 @@ class PortParams(_CommonParams):
     for fewer), and ``MapWorld.params.n_moored`` says how many were moored."""
     moored_assets: tuple[_Berth, ...] = DEFAULT_MOORED_ASSETS
     """Candidate moored ships: ``(asset_name, length_m, beam_m)``, the size its berth is laid out for: the ship's
-    own length and beam (or larger, for more room), at most :data:`MOORED_SIZE_SLACK_M` less. A ship whose draft
-    reaches ``basin_depth_m`` (the 300 m container ship's 14.5 m in the default 14 m) is not moored: its berth holds
-    the longest entry that fits it and floats (set ``basin_depth_m: 16`` to moor it)."""
+    own length and beam (or larger, for more room), at most :data:`MOORED_SIZE_SLACK_M` less. No ship whose draft
+    reaches ``basin_depth_m`` is moored: an entry given that would ground is refused, and in the default list the 300 m
+    container ship (draft 14.5 m, the default basin 14 m) gives way to the longest entry that fits its berth and
+    floats (set ``basin_depth_m: 16`` to moor it)."""
     hill_height_m: float = Field(default=35.0, ge=0.0, le=200.0)
     vegetation: StrictBool = True
 
