@@ -35,19 +35,7 @@ from typing import Any
 import pytest
 import yaml
 from mmusv.held_signals import note_stop
-
-# A scenario of four frames that records in a second: one USV with a LiDAR, one target, open sea.
-_TINY = {
-    "name": "tiny",
-    "seed": 1,
-    "acquisition": {"frequency_hz": 5, "frames": 4},
-    "map": {"type": "open_sea", "seed": 0, "params": {"extent_m": 800, "islet_probability": 0.0, "n_buoys": 0}},
-    "rigs": {"r": {"preset": "lidar_only"}},
-    "vessels": [
-        {"id": "usv", "role": "usv", "asset": "usv_wamv", "rig": "r", "speed_mps": 2.0, "route": [[0, 0], [90, 0]]},
-        {"id": "tug", "role": "target", "asset": "tug_32m", "speed_mps": 2.0, "route": [[40, 20], [140, 20]]},
-    ],
-}
+from test_review_round9 import _TINY  # a 4-frame LiDAR-only scenario that records in a second
 
 
 @pytest.fixture(autouse=True)
