@@ -16,7 +16,7 @@ Three loops still went on past a swallowed stop:
 
 And a stop of ``mmusv study detection --jobs N`` (45e86dd raises a swallowed one after each wait; a plain SIGTERM
 lands there too) left the loop inside ``with ProcessPoolExecutor``, whose exit waits for every sequence submitted:
-the study ran all of them before it ended as stopped (:func:`mmusv.studies.detection.parallel._stop_jobs`).
+the study ran all of them before it ended as stopped (:func:`mmusv.batch.executors.stop_pool`).
 
 The rest was checked apart from the code under test and found as described (see the report of this round): the
 waterplane weights against a plane fitted over the disc to a single plane wave in any direction, the phase against

@@ -31,6 +31,7 @@ __all__ = [
     "available_cpus",
     "refuse_in_daemon",
     "refuse_in_worker_import",
+    "stop_pool",
     "workers_skip_unimportable_main",
 ]
 
@@ -245,6 +246,30 @@ def _stop(signum: int, frame: object) -> None:
             raise KeyboardInterrupt
         return
     os._exit(128 + signum)
+
+
+def stop_pool(pool: Any, *, signum: int, grace_s: float) -> None:
+    """Ends the jobs of ``pool`` (a ``concurrent.futures.ProcessPoolExecutor``) when the work that submitted them
+    ends early: the jobs not started are cancelled, each running process gets ``signum`` and is killed if it has not
+    ended within ``grace_s`` seconds (one deadline for all). Leaving the pool's ``with`` block alone waits for every
+    job submitted. ``mmusv train`` sends SIGINT (a model stops as Ctrl-C stops one trained in turn, its checkpoints
+    whole), the detection study's jobs SIGTERM (they write nothing). The batch's own pool is stopped otherwise
+    (:func:`_reap`: its workers ignore a second signal while they finish a recording)."""
+    import time
+
+    # the pool has no public handle on its processes, and forgets them when shut down
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for proc in processes:
+        if proc.is_alive() and proc.pid is not None:
+            with contextlib.suppress(OSError):
+                os.kill(proc.pid, signum)
+    deadline = time.monotonic() + grace_s
+    for proc in processes:
+        proc.join(max(0.0, deadline - time.monotonic()))
+        if proc.is_alive():
+            proc.kill()
+            proc.join(1.0)
 
 
 def _reap(procs: list[Any]) -> None:

@@ -23,6 +23,7 @@ import contextlib
 import json
 import math
 import os
+import signal
 import sys
 import time
 from collections.abc import Sequence
@@ -235,6 +236,8 @@ def _run(args: argparse.Namespace, stack: contextlib.ExitStack) -> int:
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor, as_completed
 
+        from mmusv.batch.executors import stop_pool
+
         print(
             f"training {', '.join(modes)} side by side: {counted(jobs, 'process', plural='processes')}, "
             f"{counted(threads, 'torch thread')} each",
@@ -253,7 +256,9 @@ def _run(args: argparse.Namespace, stack: contextlib.ExitStack) -> int:
                         failures.append(e)
                         print(f"{futures[f]}: failed: {e}", file=sys.stderr, flush=True)
             except BaseException:  # Ctrl-C, a kill: the models stop too (leaving the pool waited for them, hours)
-                _stop_workers(pool)
+                # each running model gets SIGINT and stops as Ctrl-C stops one trained in turn (its last.pt and
+                # model.pt whole, as saved last), killed if not stopped within 10 s
+                stop_pool(pool, signum=signal.SIGINT, grace_s=10.0)
                 raise
         finished = [(mode, done[mode]) for mode in modes if mode in done]
     for mode, r in finished:
@@ -282,29 +287,6 @@ def _run(args: argparse.Namespace, stack: contextlib.ExitStack) -> int:
         raise failures[0]
     print(f"total {time.perf_counter() - t0:.1f} s; score with: mmusv study detection --model {out} ...", flush=True)
     return 0
-
-
-def _stop_workers(pool: Any, *, grace_s: float = 10.0) -> None:
-    """Stops the training processes of ``pool`` (a ``ProcessPoolExecutor``) when ``mmusv train`` is interrupted:
-    the models not started are cancelled, and each running one gets SIGINT, so it stops as Ctrl-C stops a model
-    trained in turn (its ``last.pt`` and ``model.pt`` whole, as saved last), and is killed if it has not stopped
-    within ``grace_s`` seconds. Without it, a ``kill`` of ``mmusv train`` (or a Ctrl-C that reached only it) left
-    the pool waiting for every model to finish training."""
-    import signal
-
-    # the pool has no public handle on its processes, and forgets them when shut down
-    processes = list((getattr(pool, "_processes", None) or {}).values())
-    pool.shutdown(wait=False, cancel_futures=True)
-    for proc in processes:
-        if proc.is_alive() and proc.pid is not None:
-            with contextlib.suppress(OSError):
-                os.kill(proc.pid, signal.SIGINT)
-    deadline = time.monotonic() + grace_s
-    for proc in processes:
-        proc.join(max(0.0, deadline - time.monotonic()))
-        if proc.is_alive():
-            proc.kill()
-            proc.join(1.0)
 
 
 def _check_same_run(out: Path, modes: list[str], *, p: Any, seed: int, identity: dict[str, Any] | None) -> None:

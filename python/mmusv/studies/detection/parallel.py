@@ -18,13 +18,14 @@ from ``mmusv study``, ``spec = ...`` and ``path = ...`` from Python.
 from __future__ import annotations
 
 import multiprocessing
+import signal
 from collections.abc import Callable
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass, replace
 from typing import Any
 
 from mmusv import arguments
-from mmusv.batch.executors import refuse_in_daemon, workers_skip_unimportable_main
+from mmusv.batch.executors import refuse_in_daemon, stop_pool, workers_skip_unimportable_main
 from mmusv.errors import InputError, MmusvError
 from mmusv.held_signals import raise_noted_stop
 from mmusv.studies.detection.sources import Dataset
@@ -96,23 +97,6 @@ def _run_task(dataset: Dataset, name: str, options: StudyOptions, spec: Detector
         return "error", str(exc), []
 
 
-def _stop_jobs(pool: ProcessPoolExecutor) -> None:
-    """Ends the jobs of ``pool`` when the study ends early (a stop: Ctrl-C, SIGTERM, or a swallowed stop raised
-    again; or a sequence's error): the sequences not started are cancelled and the running ones' processes ended
-    (they write nothing; their results would be dropped). Leaving the ``with`` block alone waited for every sequence
-    submitted: a stop of ``--jobs 1`` over six sequences ran all six before it ended."""
-    # the pool has no public handle on its processes, and forgets them when shut down
-    processes = list((getattr(pool, "_processes", None) or {}).values())
-    pool.shutdown(wait=False, cancel_futures=True)
-    for proc in processes:
-        proc.terminate()
-    for proc in processes:
-        proc.join(5.0)
-        if proc.is_alive():
-            proc.kill()
-            proc.join(1.0)
-
-
 def run_study_jobs(
     dataset: Dataset,
     *,
@@ -154,7 +138,8 @@ def run_study_jobs(
                     if progress is not None:
                         progress(done, total)
         except BaseException:  # a stop, or a sequence's error: the pool's exit waited for every sequence submitted
-            _stop_jobs(pool)
+            # (a stop of --jobs 1 over six sequences ran all six); the jobs write nothing, their results are dropped
+            stop_pool(pool, signum=signal.SIGTERM, grace_s=5.0)
             raise
     res = StudyResult.merge(options, [parts[n] for n in names])
     check_predictions_used(res)
