@@ -15,15 +15,10 @@ from mmusv.cli import main
 from mmusv.errors import ConfigError, InputError, IoError, MmusvError
 from mmusv.studies.detection.detector import load_detector
 from mmusv.studies.detection.parallel import DetectorSpec, run_study_jobs
+from mmusv.studies.detection.predictions import check_prediction_coverage, load_predictions
 from mmusv.studies.detection.robustness import Setting
 from mmusv.studies.detection.sources import resolve_dataset
-from mmusv.studies.detection.study import (
-    StudyOptions,
-    StudyResult,
-    check_prediction_coverage,
-    check_predictions_used,
-    load_predictions,
-)
+from mmusv.studies.detection.study import StudyOptions, StudyResult, check_predictions_used
 
 ROOT = Path(__file__).resolve().parents[2]
 

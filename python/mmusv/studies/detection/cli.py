@@ -198,9 +198,10 @@ def _run(args: argparse.Namespace, stack: contextlib.ExitStack) -> int:
     from mmusv.studies.detection.data import check_split
     from mmusv.studies.detection.detector import BASELINE_NOTE, load_detector
     from mmusv.studies.detection.fusion import parse_modes
+    from mmusv.studies.detection.predictions import check_prediction_coverage, load_predictions
     from mmusv.studies.detection.robustness import Setting, parse_settings
     from mmusv.studies.detection.sources import generate_dataset, resolve_dataset
-    from mmusv.studies.detection.study import StudyOptions, check_prediction_coverage, load_predictions, run_study
+    from mmusv.studies.detection.study import StudyOptions, run_study
 
     robust = args.study == "robustness"
     console = rich_console()  # text as it is: a path holding brackets is no markup

@@ -9,7 +9,7 @@
 
 It is selected on the command line as ``--detector package.module:function`` (:func:`load_detector`). A model
 that cannot run in-process can instead hand over its predictions as a Parquet file (``--predictions``, see
-:mod:`mmusv.studies.detection.study`).
+:mod:`mmusv.studies.detection.predictions`).
 
 **Baseline** (:func:`baseline_detect`, the default). Deterministic, no training, no GPU. It is *not* the learned
 model of the paper (a PointPillars-style network), so its absolute numbers are not the paper's:

@@ -53,7 +53,7 @@ class DetectorSpec:
     def build(self) -> tuple[Any, Any]:
         """``(detector, predictions)`` for :class:`~mmusv.studies.detection.study.StudyOptions`."""
         if self.predictions is not None:
-            from mmusv.studies.detection.study import load_predictions
+            from mmusv.studies.detection.predictions import load_predictions
 
             return None, load_predictions(self.predictions)
         if self.model is not None:
