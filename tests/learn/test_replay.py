@@ -89,8 +89,29 @@ def _assert_replay_is_the_detector(df: pl.DataFrame, cache: Cache, det: Any, k: 
         got_b, got_s = _rows(df, key, mode)
         assert got_b.shape == b.shape, (key, mode)
         np.testing.assert_allclose(got_s, s, rtol=1e-6)
-        np.testing.assert_allclose(got_b, b, atol=1e-3)
+        np.testing.assert_allclose(got_b, _tied_order(got_b, b, s), atol=1e-3)
     return expect
+
+
+def _tied_order(got: np.ndarray, boxes: np.ndarray, scores: np.ndarray) -> np.ndarray:
+    """``boxes`` ``(M, 7)`` (in descending ``scores``) reordered to ``got``'s order within runs of tied scores.
+
+    The replay decodes the peaks file's float32 boxes where the detector keeps float64, so two boxes whose scores
+    tie to 10⁻⁶ (two mirror-image boxes a random scorer rates alike) may rank either way round: only within such a
+    run may the order differ; every box elsewhere stays in its place."""
+    out = np.array(boxes, dtype=np.float64, copy=True)
+    i = 0
+    while i < len(scores):
+        j = i + 1
+        while j < len(scores) and np.isclose(scores[j], scores[i], rtol=1e-6, atol=0.0):
+            j += 1
+        if j - i > 1:
+            d = np.abs(got[i:j, None, :] - boxes[None, i:j, :]).max(axis=2)
+            pick = d.argmin(axis=1)
+            if len(set(pick.tolist())) == j - i:  # a one-to-one match; otherwise left as is (and the check fails)
+                out[i:j] = boxes[i:j][pick]
+        i = j
+    return out
 
 
 @pytest.mark.parametrize("refine", [False, True])
