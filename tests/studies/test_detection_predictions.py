@@ -70,7 +70,7 @@ def test_coverage_rows_cover_a_frame_without_a_detection(tmp_path: Path) -> None
 
 def test_a_file_without_a_row_covers_nothing(tmp_path: Path) -> None:
     path = tmp_path / "empty.parquet"
-    pl.DataFrame(schema={c: pl.Float64 for c in ("sequence", "frame", "ego", "mode", *BOX, "score")}).write_parquet(
+    pl.DataFrame(schema=dict.fromkeys(("sequence", "frame", "ego", "mode", *BOX, "score"), pl.Float64)).write_parquet(
         path
     )
     assert load_predictions(path) == {}
