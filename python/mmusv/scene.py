@@ -26,7 +26,17 @@ from mmusv import arguments
 from mmusv._native import core
 from mmusv.errors import GeometryError, InputError, NotFoundError
 
-__all__ = ["MAX_SURFACE_TILES", "NO_HIT", "SURFACE_TILE_M", "RayHits", "Scene", "demo_scene", "surface_tiles"]
+__all__ = [
+    "MAX_SURFACE_TILES",
+    "NO_HIT",
+    "SURFACE_TAPER_M",
+    "SURFACE_TILE_M",
+    "RayHits",
+    "Scene",
+    "demo_scene",
+    "surface_taper",
+    "surface_tiles",
+]
 
 NO_HIT = -1
 """Value of ``RayHits.instance_id`` and ``triangle_id`` where the ray hit nothing."""
@@ -34,6 +44,10 @@ NO_HIT = -1
 SURFACE_TILE_M = 32.0
 """Side of a tile of the displaced sea surface, metres (the core's ``SurfaceSpec::tile_m``, which
 :meth:`Scene.set_wave_surface` leaves at its default)."""
+SURFACE_TAPER_M = 60.0
+"""Width of the band over which the displaced sea surface's waves taper to the still level, metres: from
+``radius_m − SURFACE_TAPER_M`` to ``radius_m`` from the nearest focus (the whole radius where it is shorter), as
+:meth:`Scene.set_wave_surface` asks the core (:func:`surface_taper`)."""
 MAX_SURFACE_TILES: int = core.MAX_SURFACE_TILES
 """Most tiles one displaced sea surface may hold (the core's ``sea::MAX_TILES``, which it refuses past itself).
 The core samples the rectangle around every focus (out to ``radius_m``) as one grid of :data:`SURFACE_TILE_M`
@@ -132,6 +146,22 @@ def surface_tiles(foci: npt.ArrayLike, *, radius_m: float) -> int:
     return int(core.surface_tiles(f, radius_m=radius, tile_m=SURFACE_TILE_M))  # the core's own count
 
 
+def surface_taper(xy: npt.ArrayLike, *, foci: npt.ArrayLike, radius_m: float) -> npt.NDArray[np.float64]:
+    """``(N,)`` float64 share of the waves the displaced sea surface around ``foci`` ``(F, 2)`` keeps at the points
+    ``xy`` ``(N, 2)`` (world x, y, metres) with radius ``radius_m`` (metres, > 0), as the core tapers each node
+    (``sea::surface::sample``): 1 within ``radius_m − taper`` of the nearest focus, falling linearly to 0 at
+    ``radius_m`` and 0 beyond (the still level), ``taper`` = min(:data:`SURFACE_TAPER_M`, ``radius_m``); the
+    surface's elevation and slopes there are the waves' times this share. 0 everywhere without foci."""
+    p = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+    f = np.asarray(foci, dtype=np.float64).reshape(-1, 2)
+    radius = float(radius_m)
+    if len(f) == 0 or len(p) == 0:
+        return np.zeros(len(p))
+    d = np.sqrt(((p[:, None, :] - f[None, :, :]) ** 2).sum(axis=2)).min(axis=1)
+    width = min(SURFACE_TAPER_M, radius)
+    return np.asarray(np.clip((radius - d) / max(width, 1e-6), 0.0, 1.0))
+
+
 _SEA_FIELDS = ("hs_m", "tp_s", "gamma", "direction_rad", "spread_s")
 
 
@@ -191,7 +221,7 @@ def _surface_args(
         "time_s": t,
         "foci": f,
         "radius_m": radius,
-        "taper_m": min(60.0, radius),
+        "taper_m": min(SURFACE_TAPER_M, radius),
         "fine_m": fine,
         **flags,
     }

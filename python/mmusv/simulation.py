@@ -34,7 +34,7 @@ from mmusv.config import Scenario, VesselConfig, load_scenario
 from mmusv.errors import ConfigError
 from mmusv.motion import build_fleet, build_moored_fleet
 from mmusv.scenario_assets import holding_library
-from mmusv.scene import MAX_SURFACE_TILES, SURFACE_TILE_M, SeaState, check_sea, surface_tiles
+from mmusv.scene import MAX_SURFACE_TILES, SURFACE_TILE_M, SeaState, check_sea, surface_taper, surface_tiles
 from mmusv.seeds import sensor_seed
 from mmusv.sensors.camera import CameraImages
 from mmusv.sensors.config import RigConfig
@@ -233,7 +233,8 @@ class Simulation:
     @one_at_a_time
     def set_frame(self, frame: int, *, sea_radius_m: float = 320.0, shading_detail: bool = True) -> WorldState:
         """Moves every vessel to its pose at ``frame`` (and, over a physical sea, the water to its surface at the
-        frame time, displaced out to ``sea_radius_m`` around every USV: :meth:`set_sea_surface`) and returns the
+        frame time, displaced out to ``sea_radius_m`` around every USV: :meth:`set_sea_surface`, and the map's
+        buoys onto that water, their motion tapered where its waves are: :mod:`mmusv.world.buoys`) and returns the
         world state. ``shading_detail``: sample the waves' slopes the cameras shade with, the short waves' too
         (:meth:`mmusv.scene.Scene.set_wave_surface`'s ``slopes`` and ``detail``); only rendering reads them."""
         frame = self._frame_index(frame)
@@ -245,10 +246,14 @@ class Simulation:
         self.ws.scene.set_poses(self.ws.vessel_instances, state.matrices[:n])
         if self._moored_fleet is not None:
             self.ws.scene.set_poses(self.ws.moored_instances, state.matrices[n:])
+        surface = self.sea is not None and "water" in self.ws.static_instances
         if self._buoy_field is not None:
             rest = self.world.priors.buoys
-            self.ws.scene.set_poses(self.ws.buoy_instances, buoy_matrices(self._buoy_field, rest, state.time_s))
-        if self.sea is not None and "water" in self.ws.static_instances:
+            # On the sampled surface's taper (and the still water beyond) the buoys float as that water lies.
+            taper = surface_taper(rest, foci=self._foci(state), radius_m=sea_radius_m) if surface else None
+            poses = buoy_matrices(self._buoy_field, rest, state.time_s, taper=taper)
+            self.ws.scene.set_poses(self.ws.buoy_instances, poses)
+        if surface:
             self.ws.scene.set_wave_surface(self.sea, **self._surface_of(state, sea_radius_m, shading_detail))
         self._frame = frame
         return state
@@ -269,10 +274,14 @@ class Simulation:
         self._ahead = (frame, state)  # a function of the frame alone: set_frame(frame) takes it
         self.ws.scene.prefetch_wave_surface(self.sea, **self._surface_of(state, sea_radius_m, shading_detail))
 
+    def _foci(self, state: WorldState) -> np.ndarray:
+        """``(F, 2)`` float32 world x, y of the USVs in ``state``: the foci of the sampled sea surface."""
+        return np.array([state.poses[a.index, :2] for a in self.agents], dtype=np.float32).reshape(-1, 2)
+
     def _surface_of(self, state: WorldState, radius_m: float, detail: bool) -> dict[str, Any]:
         """The wave surface arguments of ``state`` (after the sea): finest around the USVs, which must lie close
         enough together for one sampled surface to span them (:data:`~mmusv.scene.MAX_SURFACE_TILES`)."""
-        foci = np.array([state.poses[a.index, :2] for a in self.agents], dtype=np.float32).reshape(-1, 2)
+        foci = self._foci(state)
         if surface_tiles(foci, radius_m=radius_m) > MAX_SURFACE_TILES:
             lo, hi = foci.min(axis=0), foci.max(axis=0)
             # The side of the largest square surface, less the tile the rounding may add.

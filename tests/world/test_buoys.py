@@ -33,7 +33,7 @@ def _scenario(*, motion: str) -> dict[str, Any]:
         "acquisition": {"frequency_hz": 2, "frames": 8},
         "rigs": {"r": {"preset": "lidar_only"}},
         "vessels": [{"id": "usv", "role": "usv", "asset": "usv_wamv", "rig": "r", "speed_mps": 2.0,
-                     "route": [[-300, -300], [-200, -300]]}],
+                     "route": [[0, -200], [100, -200]]}],
     }  # fmt: skip
 
 
@@ -125,13 +125,21 @@ def test_each_buoy_is_its_own_instance_and_rides_the_sea(motion: str) -> None:
     others = set(sim.ws.static_instances.values()) | set(sim.ws.vessel_instances.tolist())
     assert not set(ids.tolist()) & others
     field = sim.scenario.environment.sea_spec().field(scenario_seed=sim.scenario.seed)
-    tops = []
+    tops, shares = [], []
     for frame in (0, 3, 7):
         t = frame / 2.0
         if motion == "physical":
-            # The mark's tip stands its height above the water over the float, along that water's plane's normal.
+            # The mark's tip stands its height above the water over the float, along that water's plane's normal;
+            # where the sensed surface tapers its waves to the still level (260-320 m from the USV: buoy 3 here,
+            # buoy 2 beyond it), that plane's height and slopes taper alike.
             height, normal = _waterplane_fit(field, xy, t)
-            tip = np.column_stack([xy, height]) + MARK_TOP_M * normal
+            usv = sim.world_state(frame).poses[0, :2]
+            share = np.clip((320.0 - np.linalg.norm(xy - usv, axis=1)) / 60.0, 0.0, 1.0)
+            shares.append(share)
+            slopes = -normal[:, :2] / normal[:, 2:] * share[:, None]
+            normal = np.column_stack([-slopes, np.ones(len(xy))])
+            normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+            tip = np.column_stack([xy, share * height]) + MARK_TOP_M * normal
         else:  # the paper's flat water: at rest
             tip = np.column_stack([xy, np.full(len(xy), MARK_TOP_M)])
         inst, cls, z = _marks(sim, frame, tip[:, :2])
@@ -140,3 +148,6 @@ def test_each_buoy_is_its_own_instance_and_rides_the_sea(motion: str) -> None:
         tops.append(z)
     moved = np.ptp(np.array(tops), axis=0).max()
     assert moved > 0.5 if motion == "physical" else moved == 0.0
+    if motion == "physical":  # buoys in the full waves, in the taper and beyond it
+        kinds = {("full" if v == 1.0 else "still" if v == 0.0 else "taper") for v in np.concatenate(shares)}
+        assert kinds == {"full", "taper", "still"}

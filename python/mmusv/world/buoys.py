@@ -17,7 +17,10 @@ tilted 8° rms, up to 27°, alike at every sea state from W0 to W3). Not modelle
 resonances and their dynamic amplification, the pressure's decay to the draft (``e^{−kd}``), its mooring's pull and
 its drift.
 
-Over a still sea, or with ``motion: paper`` (the paper's water is a flat plane), the buoys stand at rest.
+Over a still sea, or with ``motion: paper`` (the paper's water is a flat plane), the buoys stand at rest. Where
+the sampled sea surface tapers its waves to the still level (a level-of-detail device, 260–320 m from the nearest
+USV by default: :func:`mmusv.scene.surface_taper`), a buoy's heave and tilt taper with them, so that it floats in
+the water the sensors see; beyond, it stands upright at the still level, as that water lies.
 """
 
 from __future__ import annotations
@@ -46,7 +49,12 @@ def waterplane_weights(k: npt.ArrayLike, radius_m: float) -> tuple[npt.NDArray[n
 
 
 def buoy_poses(
-    field: Any | None, xy: npt.ArrayLike, t: float, *, radius_m: float = BUOY_FLOAT_RADIUS_M
+    field: Any | None,
+    xy: npt.ArrayLike,
+    t: float,
+    *,
+    radius_m: float = BUOY_FLOAT_RADIUS_M,
+    taper: npt.ArrayLike | None = None,
 ) -> npt.NDArray[np.float64]:
     """``(B, 6)`` float64 poses ``[x, y, z, roll, pitch, yaw]`` (world frame, metres, radians; yaw 0, the buoys
     being round) of ``B`` buoys at rest positions ``xy`` ``(B, 2)`` (world metres) riding the wave field ``field``
@@ -54,7 +62,9 @@ def buoy_poses(
     elevation over the waterplane and the rotation ``Ry(pitch)·Rx(roll)`` taking the buoy's axis to the normal of
     the plane fitted to the surface there (the module's model, from the field's components); the body's origin is
     its waterline point, so at rest ``[x, y, 0, 0, 0, 0]``, as where ``field`` is ``None`` (a still sea, or
-    ``motion: paper``)."""
+    ``motion: paper``). ``taper`` ``(B,)`` in [0, 1] scales each buoy's elevation and slopes as the sampled sea
+    surface scales the waves where it tapers to the still level (:func:`mmusv.scene.surface_taper`): a buoy beyond
+    it stands upright at the still level of the water drawn there, as the sensors see it."""
     p = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
     out = np.zeros((p.shape[0], 6), dtype=np.float64)
     out[:, :2] = p
@@ -63,11 +73,12 @@ def buoy_poses(
     a, omega, k, direction, phase0 = np.asarray(field.components(), dtype=np.float64).reshape(-1, 5).T
     kx, ky = k * np.cos(direction), k * np.sin(direction)
     heave, tilt = waterplane_weights(k, radius_m)
+    share = np.ones(p.shape[0]) if taper is None else np.asarray(taper, dtype=np.float64).reshape(p.shape[0])
     # the field's phase convention (mmusv_core::ocean::WaveComponent::phase_at): k·x − ωt + φ
     phase = p[:, :1] * kx + p[:, 1:] * ky - omega * float(t) + phase0
-    out[:, 2] = np.cos(phase) @ (a * heave)
+    out[:, 2] = share * (np.cos(phase) @ (a * heave))
     sin = np.sin(phase)
-    sx, sy = -(sin @ (a * tilt * kx)), -(sin @ (a * tilt * ky))
+    sx, sy = -share * (sin @ (a * tilt * kx)), -share * (sin @ (a * tilt * ky))
     # R·e_z = (sin p cos r, −sin r, cos p cos r) = (−sx, −sy, 1) / N (pose_matrices' R = Rz(yaw)·Ry(pitch)·Rx(roll)).
     norm = np.sqrt(1.0 + sx**2 + sy**2)
     out[:, 3] = np.arcsin(sy / norm)
@@ -76,7 +87,12 @@ def buoy_poses(
 
 
 def buoy_matrices(
-    field: Any | None, xy: npt.ArrayLike, t: float, *, radius_m: float = BUOY_FLOAT_RADIUS_M
+    field: Any | None,
+    xy: npt.ArrayLike,
+    t: float,
+    *,
+    radius_m: float = BUOY_FLOAT_RADIUS_M,
+    taper: npt.ArrayLike | None = None,
 ) -> npt.NDArray[np.float64]:
     """``(B, 4, 4)`` float64 body -> world matrices of :func:`buoy_poses` (at rest where ``field`` is ``None``)."""
-    return pose_matrices(buoy_poses(field, xy, t, radius_m=radius_m))
+    return pose_matrices(buoy_poses(field, xy, t, radius_m=radius_m, taper=taper))
