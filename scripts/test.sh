@@ -67,9 +67,9 @@ echo "== type stubs match the compiled module (mypy stubtest) and the package ty
 python3 -m mypy.stubtest mmusv._core
 python3 -m mypy
 
-echo "== pytest"
+echo "== pytest (the 25 slowest tests listed at the end)"
 set +e
-python3 -m pytest -q -p no:dash -p no:cacheprovider tests
+python3 -m pytest -q -p no:dash -p no:cacheprovider --durations=25 tests
 rc=$?
 set -e
 if [ "$rc" = "5" ]; then
