@@ -461,7 +461,7 @@ TARGETS: list[tuple[str, list[tuple[str | None, str, str]]]] = [
     ("PS.set_poses", [(None, "[0]", "q"), (None, "P[None].copy()", "a")]),
     ("PS.wave_heights", [(None, "np.zeros((3, 2), np.float32)", "a")]),
     ("PS.instance_aabb", [(None, "0", "i")]),
-    ("mmusv.scene.surface_tiles", [(None, "np.zeros((2, 2))", "a"), ("radius_m", "320.0", "f")]),
+    ("mmusv.sea_surface.surface_tiles", [(None, "np.zeros((2, 2))", "a"), ("radius_m", "320.0", "f")]),
     (
         "mmusv.scene.demo_scene",
         [("seed", "1", "i"), ("extent", "200.0", "f"), ("terrain_cells", "8", "i"), ("vessels", "2", "i")],

@@ -31,7 +31,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 @dataclass(frozen=True)
 class Sea:
-    """A directional JONSWAP sea (:class:`mmusv.scene.SeaState`)."""
+    """A directional JONSWAP sea (:class:`mmusv.sea_surface.SeaState`)."""
 
     hs_m: float
     tp_s: float

@@ -30,7 +30,8 @@ from mmusv.recording import decode_image, decode_point_cloud, frame_messages, re
 from mmusv.recording.decode import WorldFrame
 from mmusv.recording.frames import OPTICAL_IN_BODY
 from mmusv.recording.tables import SCHEMAS, read_table
-from mmusv.scene import NO_HIT, SURFACE_TILE_M, Scene, demo_scene, surface_tiles
+from mmusv.scene import NO_HIT, Scene, demo_scene
+from mmusv.sea_surface import SURFACE_TILE_M, surface_tiles
 from mmusv.sensors import RigConfig, ppi_image, sensor_env
 from mmusv.sensors.radar import RadarReturns
 from mmusv.simulation import FrameCapture, Simulation
@@ -103,6 +104,7 @@ PUBLIC = [
     "mmusv.export",
     "mmusv.generate",
     "mmusv.scene",
+    "mmusv.sea_surface",
     "mmusv.simulation",
     "mmusv.annotate",
     "mmusv.motion",

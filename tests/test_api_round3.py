@@ -19,7 +19,7 @@ from mmusv.config import load_scenario, scenario_hash
 from mmusv.errors import ConfigError, InputError, IoError
 from mmusv.export import convert
 from mmusv.recording.decode import WorldFrame
-from mmusv.scene import surface_tiles
+from mmusv.sea_surface import surface_tiles
 from tiny_scenario import lidar_scenario
 
 

@@ -8,7 +8,7 @@ import pytest
 from mmusv.config import load_scenario
 from mmusv.editor.comments import read_comments
 from mmusv.editor.document import leading_comment, scenario_file
-from mmusv.scene import surface_tiles
+from mmusv.sea_surface import surface_tiles
 from mmusv.yamlio import parse_yaml
 
 _BODY = """name: t

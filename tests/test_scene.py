@@ -36,7 +36,7 @@ from mmusv.errors import (
     MmusvError,
     NotFoundError,
 )
-from mmusv.scene import NO_HIT, SURFACE_TAPER_M, RayHits, Scene, demo_scene, surface_taper
+from mmusv.scene import NO_HIT, RayHits, Scene, demo_scene
 from mmusv.world.sea_state import sea_spec_for_preset
 
 F32 = npt.NDArray[np.float32]
@@ -1363,15 +1363,3 @@ def test_property_small_soup_matches_brute_force(params: F32, seed: int, max_ran
     assert np.isinf(hits.distance[r & ~ref.hit]).all()
     assert (hits.distance[hits.hit] < max_range).all()
     assert_consistent(hits, ref)
-
-
-def test_surface_taper_is_the_cores_linear_taper_to_the_nearest_focus() -> None:
-    """1 within radius - 60 m of the nearest focus, linear to 0 at the radius, 0 beyond; a radius under 60 m
-    tapers over the whole of it; no focus keeps no wave (the core's sea::surface::sample)."""
-    assert SURFACE_TAPER_M == 60.0
-    foci = np.array([[0.0, 0.0], [1000.0, 0.0]])
-    xy = np.array([[100.0, 0.0], [0.0, 260.0], [290.0, 0.0], [0.0, -305.0], [320.0, 0.0], [500.0, 0.0], [710.0, 0.0]])
-    np.testing.assert_allclose(surface_taper(xy, foci=foci, radius_m=320.0), [1.0, 1.0, 0.5, 0.25, 0.0, 0.0, 0.5])
-    small = surface_taper([[10.0, 0.0], [0.0, 30.0]], foci=[[0.0, 0.0]], radius_m=40.0)
-    np.testing.assert_allclose(small, [0.75, 0.25])
-    np.testing.assert_array_equal(surface_taper(xy, foci=np.zeros((0, 2)), radius_m=320.0), np.zeros(len(xy)))

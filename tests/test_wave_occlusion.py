@@ -31,7 +31,7 @@ from refusals import unrefused
 
 @dataclass(frozen=True)
 class Sea:
-    """A directional JONSWAP sea (the fields :class:`mmusv.scene.SeaState` asks for)."""
+    """A directional JONSWAP sea (the fields :class:`mmusv.sea_surface.SeaState` asks for)."""
 
     hs_m: float
     tp_s: float

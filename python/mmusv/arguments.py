@@ -37,6 +37,7 @@ __all__ = [
     "path",
     "real",
     "reals",
+    "rows",
     "shown",
     "whole",
 ]
@@ -227,6 +228,28 @@ def reals(
     if a.ndim < len(tail) or a.shape[a.ndim - len(tail) :] != tail:
         raise error(f"{name} must be {what}, got shape {a.shape}")
     return a
+
+
+def rows(
+    value: Any, *, name: str, dtype: Any, tail: tuple[int, ...], error: type[Exception] = ConfigError
+) -> np.ndarray:
+    """``value``, numbers of shape ``(N, *tail)``, as a C-contiguous array of ``dtype`` (values past a float32's range
+    become inf, for the caller's finiteness check to name), else ``error`` naming ``name``: not numbers (true/false,
+    text, objects), complex numbers, another shape, or real numbers where ``dtype`` is an integer type."""
+    try:
+        arr = np.asarray(value)
+    except Exception as exc:
+        raise error(f"{name} could not be converted to an array: {exc}") from None
+    if arr.dtype == object or not np.issubdtype(arr.dtype, np.number):
+        raise error(f"{name} must be numeric, got dtype {arr.dtype}")
+    if np.iscomplexobj(arr):
+        raise error(f"{name} must be real, got complex dtype {arr.dtype}")
+    if arr.ndim != 1 + len(tail) or tuple(arr.shape[1:]) != tail:
+        raise error(f"{name} must have shape (N, {', '.join(str(s) for s in tail)}), got {arr.shape}")
+    if np.issubdtype(dtype, np.integer) and not np.issubdtype(arr.dtype, np.integer):
+        raise error(f"{name} must be an integer array, got dtype {arr.dtype}")
+    with np.errstate(over="ignore", invalid="ignore"):
+        return np.ascontiguousarray(arr, dtype=dtype)
 
 
 def holds_true_false(value: Any, raw: np.ndarray) -> bool:

@@ -14,10 +14,9 @@ Example::
 
 from __future__ import annotations
 
-import math
 import os
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -25,61 +24,21 @@ import numpy.typing as npt
 from mmusv import arguments
 from mmusv._native import core
 from mmusv.errors import GeometryError, InputError, NotFoundError
+from mmusv.sea_surface import SeaState, surface_args
 
 __all__ = [
-    "MAX_SURFACE_TILES",
     "NO_HIT",
-    "SURFACE_TAPER_M",
-    "SURFACE_TILE_M",
     "RayHits",
     "Scene",
     "demo_scene",
-    "surface_taper",
-    "surface_tiles",
 ]
 
 NO_HIT = -1
 """Value of ``RayHits.instance_id`` and ``triangle_id`` where the ray hit nothing."""
 
-SURFACE_TILE_M = 32.0
-"""Side of a tile of the displaced sea surface, metres (the core's ``SurfaceSpec::tile_m``, which
-:meth:`Scene.set_wave_surface` leaves at its default)."""
-SURFACE_TAPER_M = 60.0
-"""Width of the band over which the displaced sea surface's waves taper to the still level, metres: from
-``radius_m − SURFACE_TAPER_M`` to ``radius_m`` from the nearest focus (the whole radius where it is shorter), as
-:meth:`Scene.set_wave_surface` asks the core (:func:`surface_taper`)."""
-MAX_SURFACE_TILES: int = core.MAX_SURFACE_TILES
-"""Most tiles one displaced sea surface may hold (the core's ``sea::MAX_TILES``, which it refuses past itself).
-The core samples the rectangle around every focus (out to ``radius_m``) as one grid of :data:`SURFACE_TILE_M`
-tiles, so foci far apart (or a huge radius) would ask for more memory than any machine has: 2²² tiles is a square
-of about 65 km a side, beyond any map."""
 MAX_DEMO_CELLS: int = core.MAX_DEMO_SIZE
 """Largest ``terrain_cells`` and ``vessels`` of :func:`demo_scene` (4096² cells: 33 million terrain triangles; the
 core's bound, which it checks itself)."""
-
-
-class SeaState(Protocol):
-    """A directional JONSWAP sea as the wave surface takes it (the ocean's sea specification has these)."""
-
-    @property
-    def hs_m(self) -> float:
-        """Significant wave height, metres."""
-
-    @property
-    def tp_s(self) -> float:
-        """Peak period, seconds."""
-
-    @property
-    def gamma(self) -> float:
-        """JONSWAP peak enhancement."""
-
-    @property
-    def direction_rad(self) -> float:
-        """Mean travel direction, radians, counter-clockwise from world +x."""
-
-    @property
-    def spread_s(self) -> float:
-        """cos-2s spreading exponent."""
 
 
 @dataclass(frozen=True)
@@ -111,8 +70,8 @@ class RayHits:
         """``(N, 3)`` float32 world hit points (``nan`` rows for misses) of the ``(N, 3)`` ``origins`` and
         non-zero ``directions`` the rays were cast with."""
         n = self.distance.shape[0]
-        o = _array(origins, name="origins", dtype=np.float32, shape_tail=(3,))
-        d = _array(directions, name="directions", dtype=np.float32, shape_tail=(3,))
+        o = arguments.rows(origins, name="origins", dtype=np.float32, tail=(3,), error=InputError)
+        d = arguments.rows(directions, name="directions", dtype=np.float32, tail=(3,), error=InputError)
         if o.shape[0] != n or d.shape[0] != n:
             raise InputError(
                 f"points: got {o.shape[0]} origins and {d.shape[0]} directions for {n} rays; give the arrays the rays "
@@ -126,125 +85,6 @@ class RayHits:
             p: npt.NDArray[np.float32] = o + d * self.distance[:, None]
         p[~self.hit] = np.nan
         return p.astype(np.float32, copy=False)
-
-
-def surface_tiles(foci: npt.ArrayLike, *, radius_m: float) -> int:
-    """How many tiles the displaced sea surface around ``foci`` ``(F, 2)`` (world x, y, metres) out to
-    ``radius_m`` (metres) holds: the core samples their bounding rectangle, grown by ``radius_m``, as one grid of
-    :data:`SURFACE_TILE_M` tiles aligned on multiples of :data:`SURFACE_TILE_M` (so a side may take one tile more
-    than its length over the tile's); 0 without foci. ``foci`` must be finite (cast to float32) and ``radius_m`` a
-    finite number > 0, else an :class:`~mmusv.errors.InputError` naming the argument."""
-    if isinstance(foci, (list, tuple, np.ndarray)) and np.shape(foci) == (0,):  # no foci: ``[]`` is (0,), not (0, 2)
-        foci = np.zeros((0, 2), dtype=np.float32)
-    f = _array(foci, name="foci", dtype=np.float32, shape_tail=(2,))
-    if not np.isfinite(f).all():
-        bad = int(np.count_nonzero(~np.isfinite(f).all(axis=1)))
-        raise InputError(
-            f"foci: every focus must be a finite world x, y (metres, within float32); {bad} of {len(f)} are not"
-        )
-    radius = arguments.real(radius_m, name="radius_m", unit="metres", above=0.0, error=InputError)
-    return int(core.surface_tiles(f, radius_m=radius, tile_m=SURFACE_TILE_M))  # the core's own count
-
-
-def surface_taper(xy: npt.ArrayLike, *, foci: npt.ArrayLike, radius_m: float) -> npt.NDArray[np.float64]:
-    """``(N,)`` float64 share of the waves the displaced sea surface around ``foci`` ``(F, 2)`` keeps at the points
-    ``xy`` ``(N, 2)`` (world x, y, metres) with radius ``radius_m`` (metres, > 0), as the core tapers each node
-    (``sea::surface::sample``): 1 within ``radius_m − taper`` of the nearest focus, falling linearly to 0 at
-    ``radius_m`` and 0 beyond (the still level), ``taper`` = min(:data:`SURFACE_TAPER_M`, ``radius_m``); the
-    surface's elevation and slopes there are the waves' times this share. 0 everywhere without foci."""
-    p = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
-    f = np.asarray(foci, dtype=np.float64).reshape(-1, 2)
-    radius = float(radius_m)
-    if len(f) == 0 or len(p) == 0:
-        return np.zeros(len(p))
-    d = np.sqrt(((p[:, None, :] - f[None, :, :]) ** 2).sum(axis=2)).min(axis=1)
-    width = min(SURFACE_TAPER_M, radius)
-    return np.asarray(np.clip((radius - d) / max(width, 1e-6), 0.0, 1.0))
-
-
-_SEA_FIELDS = ("hs_m", "tp_s", "gamma", "direction_rad", "spread_s")
-
-
-def check_sea(sea: Any, *, name: str, error: type[Exception] = InputError) -> None:
-    """``sea`` must be ``None`` or a :class:`SeaState` (e.g. :class:`~mmusv.world.sea_state.SeaSpec`): an object
-    with the real numbers ``hs_m``, ``tp_s``, ``gamma``, ``direction_rad`` and ``spread_s``."""
-    if sea is None:
-        return
-    missing = [k for k in _SEA_FIELDS if not hasattr(sea, k)]
-    if missing:
-        raise error(
-            f"{name} = {arguments.shown(sea)}: must be a sea state such as mmusv.world.sea_state.SeaSpec "
-            f"(sea_spec_for_preset('4'), sea_spec_for_height(2.0)) with {', '.join(_SEA_FIELDS)}, or None; "
-            f"{type(sea).__name__} has no {', '.join(missing)}"
-        )
-    for k in _SEA_FIELDS:
-        arguments.real(getattr(sea, k), name=f"{name}.{k}", error=error)
-
-
-def _surface_args(
-    sea: SeaState | None,
-    scenario_seed: int,
-    time_s: float,
-    foci: npt.ArrayLike,
-    radius_m: float,
-    detail: bool,
-    slopes: bool,
-    fine_m: float,
-) -> tuple[float | None, dict[str, Any]]:
-    """The native ``set_wave_surface`` / ``prefetch_wave_surface`` arguments of :meth:`Scene.set_wave_surface`'s:
-    ``hs_m`` (``None`` without a sea) and the keywords."""
-    check_sea(sea, name="sea")
-    if sea is None:
-        return None, {}
-    f = _array(foci, name="foci", dtype=np.float32, shape_tail=(2,))
-    seed = arguments.whole(scenario_seed, name="scenario_seed", lo=0, hi=2**64 - 1, error=InputError)
-    t = arguments.real(time_s, name="time_s", unit="seconds", error=InputError)
-    radius = arguments.real(radius_m, name="radius_m", unit="metres", above=0.0, error=InputError)
-    fine = arguments.real(fine_m, name="fine_m", unit="metres", lo=0.0, error=InputError)
-    flags = {k: arguments.flag(v, name=k, error=InputError) for k, v in (("detail", detail), ("slopes", slopes))}
-    if np.isfinite(f).all():  # (non-finite foci: the core names them)
-        tiles = surface_tiles(f, radius_m=radius)
-        if tiles > MAX_SURFACE_TILES:
-            span = f.max(axis=0) - f.min(axis=0)
-            raise InputError(
-                f"the sea surface around foci spanning {span[0]:.0f} m x {span[1]:.0f} m out to radius_m = {radius:g} "
-                f"would hold {float(tiles):.3g} tiles of {SURFACE_TILE_M:g} m; at most {MAX_SURFACE_TILES} (a square "
-                f"of about {math.sqrt(MAX_SURFACE_TILES) * SURFACE_TILE_M / 1000.0:.0f} km): bring the foci closer "
-                "together or lower radius_m"
-            )
-    return float(sea.hs_m), {
-        "tp_s": float(sea.tp_s),
-        "gamma": float(sea.gamma),
-        "direction_rad": float(sea.direction_rad),
-        "spread_s": float(sea.spread_s),
-        "scenario_seed": seed,
-        "time_s": t,
-        "foci": f,
-        "radius_m": radius,
-        "taper_m": min(SURFACE_TAPER_M, radius),
-        "fine_m": fine,
-        **flags,
-    }
-
-
-def _array(value: Any, *, name: str, dtype: Any, shape_tail: tuple[int, ...]) -> np.ndarray:
-    """Coerces ``value`` to a C-contiguous array of ``dtype`` with trailing shape ``shape_tail``."""
-    try:
-        arr = np.asarray(value)
-    except Exception as exc:
-        raise InputError(f"{name} could not be converted to an array: {exc}") from None
-    if arr.dtype == object or not np.issubdtype(arr.dtype, np.number):
-        raise InputError(f"{name} must be numeric, got dtype {arr.dtype}")
-    if np.iscomplexobj(arr):
-        raise InputError(f"{name} must be real, got complex dtype {arr.dtype}")
-    want_ndim = 1 + len(shape_tail)
-    if arr.ndim != want_ndim or tuple(arr.shape[1:]) != shape_tail:
-        tail = ", ".join(str(s) for s in shape_tail)
-        raise InputError(f"{name} must have shape (N, {tail}), got {arr.shape}")
-    if np.issubdtype(dtype, np.integer) and not np.issubdtype(arr.dtype, np.integer):
-        raise InputError(f"{name} must be an integer array, got dtype {arr.dtype}")
-    with np.errstate(over="ignore", invalid="ignore"):  # values past float32 become inf, which the checks name
-        return np.ascontiguousarray(arr, dtype=dtype)
 
 
 def _floats(value: Any, *, name: str) -> np.ndarray:
@@ -337,14 +177,14 @@ class Scene:
         """
         if not isinstance(name, str):
             raise InputError(f"name = {arguments.shown(name)}: must be a str (free text), not {type(name).__name__}")
-        v = _array(vertices, name="vertices", dtype=np.float32, shape_tail=(3,))
+        v = arguments.rows(vertices, name="vertices", dtype=np.float32, tail=(3,), error=InputError)
         raw_faces = np.asarray(faces)
         if raw_faces.dtype.kind == "u" and raw_faces.size and int(raw_faces.max()) >= 2**63:
             raise GeometryError(
                 f"invalid geometry in faces: index {int(raw_faces.max())} lies outside the {v.shape[0]} vertices; "
                 f"indices must be in 0..{v.shape[0] - 1}"
             )
-        f = _array(raw_faces, name="faces", dtype=np.int64, shape_tail=(3,))
+        f = arguments.rows(raw_faces, name="faces", dtype=np.int64, tail=(3,), error=InputError)
         c = _uint16s(classes, name="classes")
         if v.shape[0] and not np.isfinite(np.asarray(vertices, dtype=np.float64)).all():
             bad = int(np.argwhere(~np.isfinite(np.asarray(vertices, dtype=np.float64)).all(axis=1))[0, 0])
@@ -483,7 +323,16 @@ class Scene:
                 showing the levels' edges as squares around its USV. The simulation sets it to its top views'
                 reach; the geometry is the same either way.
         """
-        hs, kw = _surface_args(sea, scenario_seed, time_s, foci, radius_m, detail, slopes, fine_m)
+        hs, kw = surface_args(
+            sea,
+            scenario_seed=scenario_seed,
+            time_s=time_s,
+            foci=foci,
+            radius_m=radius_m,
+            detail=detail,
+            slopes=slopes,
+            fine_m=fine_m,
+        )
         self._native.set_wave_surface(hs, **kw)
 
     def prefetch_wave_surface(
@@ -503,13 +352,22 @@ class Scene:
         :meth:`~mmusv.simulation.Simulation.prefetch_frame` does); that call then takes it instead of sampling it
         again, and any other call leaves it unused. The same surface bit for bit. Arguments as for
         :meth:`set_wave_surface`, checked now; ``sea=None`` drops a surface being sampled ahead."""
-        hs, kw = _surface_args(sea, scenario_seed, time_s, foci, radius_m, detail, slopes, fine_m)
+        hs, kw = surface_args(
+            sea,
+            scenario_seed=scenario_seed,
+            time_s=time_s,
+            foci=foci,
+            radius_m=radius_m,
+            detail=detail,
+            slopes=slopes,
+            fine_m=fine_m,
+        )
         self._native.prefetch_wave_surface(hs, **kw)
 
     def wave_heights(self, xy: npt.ArrayLike) -> npt.NDArray[np.float32]:
         """``(N,)`` float32 world z of the sea surface at ``xy`` ``(N, 2)`` finite world x, y (metres): the
         displaced surface of :meth:`set_wave_surface`, or the still level 0 where there is none."""
-        p = _array(xy, name="xy", dtype=np.float32, shape_tail=(2,))
+        p = arguments.rows(xy, name="xy", dtype=np.float32, tail=(2,), error=InputError)
         bad = np.flatnonzero(~np.isfinite(p).all(axis=1))
         if bad.size:
             raise InputError(f"invalid xy[{int(bad[0])}]: {p[bad[0]].tolist()} is not finite; give world x, y, metres")
@@ -541,8 +399,8 @@ class Scene:
             directions: ``(N, 3)`` float, world frame; any non-zero length (normalised internally).
             max_range: metres; hits farther than this are misses.
         """
-        o = _array(origins, name="origins", dtype=np.float32, shape_tail=(3,))
-        d = _array(directions, name="directions", dtype=np.float32, shape_tail=(3,))
+        o = arguments.rows(origins, name="origins", dtype=np.float32, tail=(3,), error=InputError)
+        d = arguments.rows(directions, name="directions", dtype=np.float32, tail=(3,), error=InputError)
         limit = arguments.real(max_range, name="max_range", unit="metres", above=0.0, finite=False, error=InputError)
         dist, inst, tri, normal, cls, back = self._native.cast_rays(o, d, limit)
         return RayHits(dist, inst, tri, normal, cls, back)

@@ -34,7 +34,7 @@ from mmusv.config import Scenario, VesselConfig, load_scenario
 from mmusv.errors import ConfigError
 from mmusv.motion import build_fleet, build_moored_fleet
 from mmusv.scenario_assets import holding_library
-from mmusv.scene import MAX_SURFACE_TILES, SURFACE_TILE_M, SeaState, check_sea, surface_taper, surface_tiles
+from mmusv.sea_surface import MAX_SURFACE_TILES, SURFACE_TILE_M, SeaState, check_sea, surface_taper, surface_tiles
 from mmusv.seeds import sensor_seed
 from mmusv.sensors.camera import CameraImages
 from mmusv.sensors.config import RigConfig
@@ -280,7 +280,7 @@ class Simulation:
 
     def _surface_of(self, state: WorldState, radius_m: float, detail: bool) -> dict[str, Any]:
         """The wave surface arguments of ``state`` (after the sea): finest around the USVs, which must lie close
-        enough together for one sampled surface to span them (:data:`~mmusv.scene.MAX_SURFACE_TILES`)."""
+        enough together for one sampled surface to span them (:data:`~mmusv.sea_surface.MAX_SURFACE_TILES`)."""
         foci = self._foci(state)
         if surface_tiles(foci, radius_m=radius_m) > MAX_SURFACE_TILES:
             lo, hi = foci.min(axis=0), foci.max(axis=0)
