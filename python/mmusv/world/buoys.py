@@ -19,8 +19,8 @@ its drift.
 
 Over a still sea, or with ``motion: paper`` (the paper's water is a flat plane), the buoys stand at rest. Where
 the sampled sea surface tapers its waves to the still level (a level-of-detail device, 260–320 m from the nearest
-USV by default: :func:`mmusv.sea_surface.surface_taper`), a buoy's heave and tilt taper with them, so that it floats in
-the water the sensors see; beyond, it stands upright at the still level, as that water lies.
+USV by default: :func:`mmusv.sea_surface.surface_taper`), a buoy's heave and tilt taper with them, so that it
+floats in the water the sensors see; beyond, it stands upright at the still level, as that water lies.
 """
 
 from __future__ import annotations
@@ -63,8 +63,8 @@ def buoy_poses(
     the plane fitted to the surface there (the module's model, from the field's components); the body's origin is
     its waterline point, so at rest ``[x, y, 0, 0, 0, 0]``, as where ``field`` is ``None`` (a still sea, or
     ``motion: paper``). ``taper`` ``(B,)`` in [0, 1] scales each buoy's elevation and slopes as the sampled sea
-    surface scales the waves where it tapers to the still level (:func:`mmusv.sea_surface.surface_taper`): a buoy beyond
-    it stands upright at the still level of the water drawn there, as the sensors see it."""
+    surface scales the waves where it tapers to the still level (:func:`mmusv.sea_surface.surface_taper`): a buoy
+    beyond it stands upright at the still level of the water drawn there, as the sensors see it."""
     p = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
     out = np.zeros((p.shape[0], 6), dtype=np.float64)
     out[:, :2] = p
