@@ -500,13 +500,14 @@ def test_a_time_of_day_is_one_time_in_the_config_hash() -> None:
 
 def test_turbidity_of_each_weather_s_default_visibility() -> None:
     """``mmusv.sensors.env``: ``T = 1.9 + 30 / V_km`` clamped to [1.9, 10]; a clear 20 km day 3.4, a 5 km haze 7.9.
-    The docstring said "fog and rain ... saturate it": the fog's default 500 m does, the rain's default 5 km is the
-    haze's 7.9 (the saturation is at 30 / 8.1 = 3.7 km)."""
+    The docstring said "fog and rain ... saturate it": the fog's default 500 m does, and since 2026-12-07 the rain's
+    too (2.6 km: its air's 10 km with the drops of 4 mm/h, ``mmusv.world.rain``; it was 5 km, the haze's 7.9, a
+    visibility the drops alone do not allow); the saturation is at 30 / 8.1 = 3.7 km."""
     from mmusv.sensors.env import turbidity_from_visibility
     from mmusv.world.environment import Weather
 
     t = {w: turbidity_from_visibility(Weather.make(w).visibility_m) for w in ("clear", "overcast", "fog", "rain")}
-    assert t == pytest.approx({"clear": 3.4, "overcast": 4.9, "fog": 10.0, "rain": 7.9}), t
+    assert t == pytest.approx({"clear": 3.4, "overcast": 4.9, "fog": 10.0, "rain": 10.0}), t
     assert turbidity_from_visibility(3704.0) < 10.0 == turbidity_from_visibility(3703.0)
     doc = " ".join((mmusv.sensors.env.__doc__ or "").split())
     assert "any visibility under 3.7 km saturates it" in doc and "fog and rain, whose skies are overcast" not in doc

@@ -198,8 +198,9 @@ class SeaConfig(_Model):
 
 
 class EnvironmentConfig(_Model):
-    """Time of day (``"HH:MM"``), weather, visibility, rain (a rate above 0 needs a sky that rains: ``weather`` other
-    than ``clear``), the wave setting (``W0``..``W3`` or metres), the
+    """Time of day (``"HH:MM"``), weather, visibility (metres, in the rain where it rains; left out, the weather's
+    own air thinned by its rain's drops: :meth:`mmusv.world.environment.Weather.make`), rain (a rate above 0 needs a
+    sky that rains: ``weather`` other than ``clear``), the wave setting (``W0``..``W3`` or metres), the
     physical ``sea`` (optional; else it follows ``wave``) and the vessels' ``motion``: ``physical`` (default: each
     hull's response to the sea through its RAOs) or ``paper`` (the paper's formula, driven by ``wave``)."""
 

@@ -11,7 +11,8 @@ and waves.
 * **Turbidity** from the meteorological visibility ``V``: ``T = 1.9 + 30 / V_km``, clamped to [1.9, 10], a
   monotone mapping chosen so that a clear 20 km day is T ≈ 3.4 and a 5 km haze T ≈ 7.9 (the range over which
   Preetham et al. 1999 fitted their model); any visibility under 3.7 km saturates it, the fog's default 500 m
-  among them (the rain's default 5 km is the haze's 7.9; both skies are overcast, cloud cover 1).
+  among them, and the rain's default 2.6 km (its air's 10 km with the drops of 4 mm/h: :mod:`mmusv.world.rain`);
+  both skies are overcast, cloud cover 1, which leaves the clear sky, and with it the turbidity, out.
 * **Wind** (m/s at 10 m), when the scenario does not give one: the wind of a fully developed Pierson–Moskowitz
   sea of the scenario's significant height. Pierson & Moskowitz (1964) give it at 19.5 m (their weather ships'
   anemometers), ``U₁₉.₅ = √(H g / 0.21)``; the whitecaps (Monahan) and the water's slopes (Cox & Munk) take the

@@ -6,7 +6,8 @@ They parameterise the motion model (wave height H scales heave, roll and pitch) 
 * Time of day ``"HH:MM"`` → sun direction from a simple solar model (declination from ``day_of_year``,
   hour angle from local solar time, latitude ``latitude_deg``), sun colour warming near the horizon, and an
   ambient level; below the horizon the sun is off.
-* Weather: ``clear``, ``overcast``, ``fog`` (with ``visibility_m``), ``rain`` (with ``rain_mm_per_h``).
+* Weather: ``clear``, ``overcast``, ``fog`` (with ``visibility_m``), ``rain`` (with ``rain_mm_per_h``); without
+  ``visibility_m``, the rain's drops thin the sky's own visibility (:mod:`mmusv.world.rain`).
 * Waves: presets ``W0``..``W3`` (H = 0.5, 1.5, 2.5, 3.5 m; amplitude A = H/2) or a free height in metres.
 
 Frames: the sun direction is a unit vector in the world frame (x east, y north, z up) pointing *towards* the
@@ -23,6 +24,7 @@ from typing import Literal
 from mmusv import arguments
 from mmusv._native import core
 from mmusv.errors import ConfigError
+from mmusv.world.rain import visibility_in_rain
 
 __all__ = [
     "MAX_WAVE_HEIGHT_M",
@@ -157,8 +159,9 @@ class Weather:
     distance at which contrast falls to 5 %); ``rain_mm_per_h``; ``cloud_cover`` in [0, 1].
 
     The visibility is the air's whole extinction for the cameras and the LiDAR, the rain's drops included (they
-    dim 905 nm as they dim visible light): with heavy rain give the visibility in it — Marshall–Palmer drops
-    alone make it about 3 / (0.365 R^0.63) km, 3.4 km at 4 mm/h, 1.9 km at 10, 0.7 km at 50. The rain rate
+    dim 905 nm as they dim visible light): a visibility given is the one in the rain; left out, it follows from
+    the rain rate (:meth:`make`, :mod:`mmusv.world.rain`) — Marshall–Palmer drops alone make it about
+    3 / (0.365 R^0.63) km, 3.4 km at 4 mm/h, 1.9 km at 10, 0.7 km at 50. The rain rate
     itself sets the cameras' streaks, the radar's rain attenuation and clutter, and a small LiDAR term
     (``crates/mmusv-core/src/sensors/lidar.rs``, step 4)."""
 
@@ -176,8 +179,11 @@ class Weather:
     def make(
         cls, kind: str = "clear", *, visibility_m: float | None = None, rain_mm_per_h: float | None = None
     ) -> Weather:
-        """Weather of ``kind`` with sensible defaults (clear 20 km visibility, overcast 10 km, fog 500 m,
-        rain 4 mm/h with 5 km)."""
+        """Weather of ``kind`` with sensible defaults: the air's visibility clear 20 km, overcast 10 km, fog 500 m,
+        rain 10 km (an overcast sky's air) and a rain rate of 4 mm/h under ``rain`` (0 under the others). Without
+        ``visibility_m`` the visibility is that air's with the rain's drops in it
+        (:func:`mmusv.world.rain.visibility_in_rain`): 2.55 km in the default rain, 1.0 km at 25 mm/h, 437 m in
+        fog with 4 mm/h falling; a visibility given is the one in the rain, its drops included, and is kept."""
         if kind not in _WEATHER:
             raise ConfigError(
                 f"invalid config environment.weather = {kind!r}: allowed values are {', '.join(_WEATHER)}"
@@ -186,17 +192,19 @@ class Weather:
             "clear": (20000.0, 0.0, 0.1),
             "overcast": (10000.0, 0.0, 0.9),
             "fog": (500.0, 0.0, 1.0),
-            "rain": (5000.0, 4.0, 1.0),
+            "rain": (10000.0, 4.0, 1.0),
         }
-        vis, rain, cloud = defaults[kind]
-        if visibility_m is not None:
-            vis = arguments.real(visibility_m, name="invalid config environment.visibility_m", unit="metres")
+        air, rain, cloud = defaults[kind]
         if rain_mm_per_h is not None:
             rain = arguments.real(rain_mm_per_h, name="invalid config environment.rain_mm_per_h", unit="mm/h")
-        if not (math.isfinite(vis) and vis > 0):
-            raise ConfigError(f"invalid config environment.visibility_m = {visibility_m}: must be > 0 metres")
         if not (math.isfinite(rain) and rain >= 0):
             raise ConfigError(f"invalid config environment.rain_mm_per_h = {rain_mm_per_h}: must be >= 0")
+        if visibility_m is None:
+            vis = visibility_in_rain(air, rain)
+        else:
+            vis = arguments.real(visibility_m, name="invalid config environment.visibility_m", unit="metres")
+        if not (math.isfinite(vis) and vis > 0):
+            raise ConfigError(f"invalid config environment.visibility_m = {visibility_m}: must be > 0 metres")
         return cls(kind, vis, rain, cloud)  # type: ignore[arg-type]
 
 
