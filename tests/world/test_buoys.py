@@ -16,8 +16,9 @@ from typing import Any
 import numpy as np
 import pytest
 from mmusv.classes import SemanticClass
+from mmusv.errors import InputError
 from mmusv.simulation import Simulation
-from mmusv.world.buoys import buoy_matrices, buoy_poses
+from mmusv.world.buoys import buoy_matrices, buoy_poses, waterplane_weights
 from mmusv.world.sea_state import sea_spec_for_preset
 
 MARK_TOP_M = 3.8
@@ -151,3 +152,31 @@ def test_each_buoy_is_its_own_instance_and_rides_the_sea(motion: str) -> None:
     if motion == "physical":  # buoys in the full waves, in the taper and beyond it
         kinds = {("full" if v == 1.0 else "still" if v == 0.0 else "taper") for v in np.concatenate(shares)}
         assert kinds == {"full", "taper", "still"}
+
+
+@pytest.mark.parametrize(
+    ("args", "kw", "err"),
+    [
+        ((None, "abc", 0.0), {}, r"xy must be numeric"),
+        ((None, [[0.0, 0.0, 0.0]], 0.0), {}, r"xy must have shape \(N, 2\), got \(1, 3\)"),
+        ((None, [[np.nan, 0.0]], 0.0), {}, r"xy: every rest position must be a finite world x, y"),
+        ((None, [[0.0, 0.0]], "1"), {}, r"t = '1': must be a finite number of seconds"),
+        ((None, [[0.0, 0.0]], np.inf), {}, r"t = inf"),
+        ((None, [[0.0, 0.0]], 0.0), {"radius_m": 0.0}, r"radius_m = 0.0: must be .* > 0"),
+        ((None, [[0.0, 0.0]], 0.0), {"taper": [0.5, 0.5]}, r"taper: must be 1 shares in \[0, 1\]"),
+        ((None, [[0.0, 0.0]], 0.0), {"taper": [1.5]}, r"taper: must be 1 shares in \[0, 1\]"),
+        ((object(), [[0.0, 0.0]], 0.0), {}, r"field = .*: must be a wave field"),
+    ],
+)
+def test_buoy_poses_names_a_bad_argument(args: tuple[Any, ...], kw: dict[str, Any], err: str) -> None:
+    """They were a bare ValueError from numpy, or numbers out of nothing (a NaN position, a negative radius)."""
+    with pytest.raises(InputError, match=err):
+        buoy_poses(*args, **kw)
+
+
+def test_waterplane_weights_name_a_bad_argument() -> None:
+    with pytest.raises(InputError, match=r"radius_m = -1: must be .* > 0"):
+        waterplane_weights([0.1, 0.2], -1)
+    with pytest.raises(InputError, match=r"k: every wavenumber must be a finite number of rad/m >= 0"):
+        waterplane_weights([-0.1], 1.2)
+    assert buoy_poses(None, [], 0.0).shape == (0, 6)

@@ -31,6 +31,8 @@ import numpy as np
 import numpy.typing as npt
 from scipy.special import jv
 
+from mmusv import arguments
+from mmusv.errors import InputError
 from mmusv.frames import pose_matrices
 from mmusv.world.port import BUOY_FLOAT_RADIUS_M
 
@@ -40,8 +42,12 @@ __all__ = ["buoy_matrices", "buoy_poses", "waterplane_weights"]
 def waterplane_weights(k: npt.ArrayLike, radius_m: float) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
     """The weights ``(heave, tilt)``, each float64 of ``k``'s shape, of plane waves of wavenumbers ``k`` (rad/m)
     over a disc of radius ``radius_m`` (m): the disc's mean of ``e^{ik·x}``, ``2·J₁(kR)/(kR)``, and its least-squares
-    slope over the wave's, ``8·J₂(kR)/(kR)²`` (module docstring); 1 at ``k = 0``."""
-    x = np.asarray(k, dtype=np.float64) * float(radius_m)
+    slope over the wave's, ``8·J₂(kR)/(kR)²`` (module docstring); 1 at ``k = 0``. ``k`` must be finite and ≥ 0 and
+    ``radius_m`` > 0, else an :class:`~mmusv.errors.InputError` naming it."""
+    kk = arguments.reals(k, name="k", what="an array", error=InputError)
+    if not (np.isfinite(kk).all() and (kk >= 0.0).all()):
+        raise InputError("k: every wavenumber must be a finite number of rad/m >= 0")
+    x = kk * arguments.real(radius_m, name="radius_m", unit="metres", above=0.0, error=InputError)
     safe = np.where(x > 1e-6, x, 1.0)
     heave = np.where(x > 1e-6, 2.0 * jv(1, safe) / safe, 1.0 - x**2 / 8.0)
     tilt = np.where(x > 1e-6, 8.0 * jv(2, safe) / safe**2, 1.0 - x**2 / 12.0)
@@ -64,8 +70,21 @@ def buoy_poses(
     its waterline point, so at rest ``[x, y, 0, 0, 0, 0]``, as where ``field`` is ``None`` (a still sea, or
     ``motion: paper``). ``taper`` ``(B,)`` in [0, 1] scales each buoy's elevation and slopes as the sampled sea
     surface scales the waves where it tapers to the still level (:func:`mmusv.sea_surface.surface_taper`): a buoy
-    beyond it stands upright at the still level of the water drawn there, as the sensors see it."""
-    p = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+    beyond it stands upright at the still level of the water drawn there, as the sensors see it. A bad argument (``xy`` not finite
+    ``(B, 2)``, ``t`` or ``radius_m`` not a finite number, ``radius_m`` ≤ 0, ``taper`` not ``B`` shares in [0, 1], a
+    ``field`` with no ``components()``) is an :class:`~mmusv.errors.InputError` naming it."""
+    p = _rest_positions(xy)
+    t = arguments.real(t, name="t", unit="seconds", error=InputError)
+    radius_m = arguments.real(radius_m, name="radius_m", unit="metres", above=0.0, error=InputError)
+    if field is not None and not callable(getattr(field, "components", None)):
+        raise InputError(
+            f"field = {arguments.shown(field)}: must be a wave field (mmusv._core.WaveField, e.g. "
+            "SeaSpec.field(scenario_seed=...)) or None (a still sea)"
+        )
+    if taper is not None:
+        taper = arguments.reals(taper, name="taper", what=f"an array of shape ({len(p)},)", error=InputError)
+        if taper.shape != (len(p),) or not ((taper >= 0.0) & (taper <= 1.0)).all():
+            raise InputError(f"taper: must be {len(p)} shares in [0, 1], one per buoy; got shape {taper.shape}")
     out = np.zeros((p.shape[0], 6), dtype=np.float64)
     out[:, :2] = p
     if field is None or p.shape[0] == 0:
@@ -73,9 +92,9 @@ def buoy_poses(
     a, omega, k, direction, phase0 = np.asarray(field.components(), dtype=np.float64).reshape(-1, 5).T
     kx, ky = k * np.cos(direction), k * np.sin(direction)
     heave, tilt = waterplane_weights(k, radius_m)
-    share = np.ones(p.shape[0]) if taper is None else np.asarray(taper, dtype=np.float64).reshape(p.shape[0])
+    share = np.ones(p.shape[0]) if taper is None else taper
     # the field's phase convention (mmusv_core::ocean::WaveComponent::phase_at): k·x − ωt + φ
-    phase = p[:, :1] * kx + p[:, 1:] * ky - omega * float(t) + phase0
+    phase = p[:, :1] * kx + p[:, 1:] * ky - omega * t + phase0
     out[:, 2] = share * (np.cos(phase) @ (a * heave))
     sin = np.sin(phase)
     sx, sy = -share * (sin @ (a * tilt * kx)), -share * (sin @ (a * tilt * ky))
@@ -84,6 +103,17 @@ def buoy_poses(
     out[:, 3] = np.arcsin(sy / norm)
     out[:, 4] = np.arctan(-sx)
     return out
+
+
+def _rest_positions(xy: npt.ArrayLike) -> npt.NDArray[np.float64]:
+    """``xy``, the buoys' rest positions, as ``(B, 2)`` float64 (an empty list: none), each finite, else an
+    :class:`~mmusv.errors.InputError` naming ``xy``."""
+    if (isinstance(xy, (list, tuple)) and not xy) or (isinstance(xy, np.ndarray) and xy.shape == (0,)):
+        return np.zeros((0, 2))
+    p = arguments.rows(xy, name="xy", dtype=np.float64, tail=(2,), error=InputError)
+    if not np.isfinite(p).all():
+        raise InputError(f"xy: every rest position must be a finite world x, y (metres); {len(p)} given")
+    return p
 
 
 def buoy_matrices(
