@@ -49,3 +49,11 @@ def test_rows_takes_numbers_of_the_given_trailing_shape_only() -> None:
             arguments.rows(value, name="xy", dtype=np.float64, tail=(2,))
     with pytest.raises(ConfigError, match=r"faces must be an integer array, got dtype float64"):
         arguments.rows([[0.0, 1.0, 2.0]], name="faces", dtype=np.int64, tail=(3,))
+
+
+def test_rows_takes_an_empty_list_as_no_rows_when_asked() -> None:
+    for value in ([], (), np.zeros(0)):
+        got = arguments.rows(value, name="xy", dtype=np.float32, tail=(2,), empty=True)
+        assert got.shape == (0, 2) and got.dtype == np.float32
+        with pytest.raises(ConfigError, match=r"xy must have shape \(N, 2\), got \(0,\)"):
+            arguments.rows(value, name="xy", dtype=np.float32, tail=(2,))

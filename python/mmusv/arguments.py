@@ -231,11 +231,22 @@ def reals(
 
 
 def rows(
-    value: Any, *, name: str, dtype: Any, tail: tuple[int, ...], error: type[Exception] = ConfigError
+    value: Any,
+    *,
+    name: str,
+    dtype: Any,
+    tail: tuple[int, ...],
+    empty: bool = False,
+    error: type[Exception] = ConfigError,
 ) -> np.ndarray:
     """``value``, numbers of shape ``(N, *tail)``, as a C-contiguous array of ``dtype`` (values past a float32's range
     become inf, for the caller's finiteness check to name), else ``error`` naming ``name``: not numbers (true/false,
-    text, objects), complex numbers, another shape, or real numbers where ``dtype`` is an integer type."""
+    text, objects), complex numbers, another shape, or real numbers where ``dtype`` is an integer type. With
+    ``empty``, an empty list or tuple, or an array of shape ``(0,)``, is no rows (numpy reads ``[]`` as ``(0,)``)."""
+    if empty and (
+        (isinstance(value, (list, tuple)) and not value) or (isinstance(value, np.ndarray) and value.shape == (0,))
+    ):
+        return np.zeros((0, *tail), dtype=dtype)
     try:
         arr = np.asarray(value)
     except Exception as exc:

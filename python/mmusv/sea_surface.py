@@ -77,7 +77,7 @@ def surface_tiles(foci: npt.ArrayLike, *, radius_m: float) -> int:
     :data:`SURFACE_TILE_M` tiles aligned on multiples of :data:`SURFACE_TILE_M` (so a side may take one tile more
     than its length over the tile's); 0 without foci. ``foci`` must be finite (cast to float32) and ``radius_m`` a
     finite number > 0, else an :class:`~mmusv.errors.InputError` naming the argument."""
-    f = _points(foci, name="foci", dtype=np.float32)
+    f = arguments.rows(foci, name="foci", dtype=np.float32, tail=(2,), empty=True, error=InputError)
     if not np.isfinite(f).all():
         bad = int(np.count_nonzero(~np.isfinite(f).all(axis=1)))
         raise InputError(
@@ -93,22 +93,14 @@ def surface_taper(xy: npt.ArrayLike, *, foci: npt.ArrayLike, radius_m: float) ->
     (``sea::surface::sample``): 1 within ``radius_m − taper`` of the nearest focus, falling linearly to 0 at
     ``radius_m`` and 0 beyond (the still level), ``taper`` = min(:data:`SURFACE_TAPER_M`, ``radius_m``); the
     surface's elevation and slopes there are the waves' times this share. 0 everywhere without foci."""
-    p, f = _points(xy, name="xy", dtype=np.float64), _points(foci, name="foci", dtype=np.float64)
+    p = arguments.rows(xy, name="xy", dtype=np.float64, tail=(2,), empty=True, error=InputError)
+    f = arguments.rows(foci, name="foci", dtype=np.float64, tail=(2,), empty=True, error=InputError)
     radius = arguments.real(radius_m, name="radius_m", unit="metres", above=0.0, error=InputError)
     if len(f) == 0 or len(p) == 0:
         return np.zeros(len(p))
     d = np.sqrt(((p[:, None, :] - f[None, :, :]) ** 2).sum(axis=2)).min(axis=1)
     width = min(SURFACE_TAPER_M, radius)
     return np.asarray(np.clip((radius - d) / max(width, 1e-6), 0.0, 1.0))
-
-
-def _points(value: Any, *, name: str, dtype: Any) -> np.ndarray:
-    """``value``, world x, y points ``(N, 2)`` (an empty list ``[]`` too: no points), as a C-contiguous array of
-    ``dtype``, else an :class:`~mmusv.errors.InputError` naming ``name``."""
-    if (isinstance(value, (list, tuple)) and not value) or (isinstance(value, np.ndarray) and value.shape == (0,)):
-        # ``[]`` is (0,), not (0, 2)
-        value = np.zeros((0, 2), dtype=dtype)
-    return arguments.rows(value, name=name, dtype=dtype, tail=(2,), error=InputError)
 
 
 _SEA_FIELDS = ("hs_m", "tp_s", "gamma", "direction_rad", "spread_s")

@@ -70,9 +70,9 @@ def buoy_poses(
     its waterline point, so at rest ``[x, y, 0, 0, 0, 0]``, as where ``field`` is ``None`` (a still sea, or
     ``motion: paper``). ``taper`` ``(B,)`` in [0, 1] scales each buoy's elevation and slopes as the sampled sea
     surface scales the waves where it tapers to the still level (:func:`mmusv.sea_surface.surface_taper`): a buoy
-    beyond it stands upright at the still level of the water drawn there, as the sensors see it. A bad argument (``xy`` not finite
-    ``(B, 2)``, ``t`` or ``radius_m`` not a finite number, ``radius_m`` ≤ 0, ``taper`` not ``B`` shares in [0, 1], a
-    ``field`` with no ``components()``) is an :class:`~mmusv.errors.InputError` naming it."""
+    beyond it stands upright at the still level of the water drawn there, as the sensors see it. A bad argument
+    (``xy`` not finite ``(B, 2)``, ``t`` or ``radius_m`` not a finite number, ``radius_m`` ≤ 0, ``taper`` not ``B``
+    shares in [0, 1], a ``field`` with no ``components()``) is an :class:`~mmusv.errors.InputError` naming it."""
     p = _rest_positions(xy)
     t = arguments.real(t, name="t", unit="seconds", error=InputError)
     radius_m = arguments.real(radius_m, name="radius_m", unit="metres", above=0.0, error=InputError)
@@ -108,9 +108,7 @@ def buoy_poses(
 def _rest_positions(xy: npt.ArrayLike) -> npt.NDArray[np.float64]:
     """``xy``, the buoys' rest positions, as ``(B, 2)`` float64 (an empty list: none), each finite, else an
     :class:`~mmusv.errors.InputError` naming ``xy``."""
-    if (isinstance(xy, (list, tuple)) and not xy) or (isinstance(xy, np.ndarray) and xy.shape == (0,)):
-        return np.zeros((0, 2))
-    p = arguments.rows(xy, name="xy", dtype=np.float64, tail=(2,), error=InputError)
+    p = arguments.rows(xy, name="xy", dtype=np.float64, tail=(2,), empty=True, error=InputError)
     if not np.isfinite(p).all():
         raise InputError(f"xy: every rest position must be a finite world x, y (metres); {len(p)} given")
     return p
