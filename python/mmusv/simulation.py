@@ -242,19 +242,21 @@ class Simulation:
         shading_detail = arguments.flag(shading_detail, name="shading_detail")
         ahead, self._ahead = self._ahead, None
         state = ahead[1] if ahead is not None and ahead[0] == frame else self.world_state(frame)
+        # The surface's arguments first: a surface too large for one grid refuses the frame before anything moves.
+        surface = self.sea is not None and "water" in self.ws.static_instances
+        waves = self._surface_of(state, sea_radius_m, shading_detail) if surface else None
         n = len(self.scenario.vessels)
         self.ws.scene.set_poses(self.ws.vessel_instances, state.matrices[:n])
         if self._moored_fleet is not None:
             self.ws.scene.set_poses(self.ws.moored_instances, state.matrices[n:])
-        surface = self.sea is not None and "water" in self.ws.static_instances
         if self._buoy_field is not None:
             rest = self.world.priors.buoys
             # On the sampled surface's taper (and the still water beyond) the buoys float as that water lies.
-            taper = surface_taper(rest, foci=self._foci(state), radius_m=sea_radius_m) if surface else None
+            taper = surface_taper(rest, foci=waves["foci"], radius_m=sea_radius_m) if waves is not None else None
             poses = buoy_matrices(self._buoy_field, rest, state.time_s, taper=taper)
             self.ws.scene.set_poses(self.ws.buoy_instances, poses)
-        if surface:
-            self.ws.scene.set_wave_surface(self.sea, **self._surface_of(state, sea_radius_m, shading_detail))
+        if waves is not None:
+            self.ws.scene.set_wave_surface(self.sea, **waves)
         self._frame = frame
         return state
 

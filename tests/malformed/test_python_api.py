@@ -168,6 +168,28 @@ def test_a_huge_sea_radius_is_refused(sim: mmusv.Simulation) -> None:
     _refused(lambda: sim.set_frame(0, sea_radius_m=1e30), ConfigError, "sea_radius_m", "give at most")
 
 
+def test_a_refused_frame_leaves_the_scene_as_it_was() -> None:
+    """``set_frame`` moved the vessels and the buoys to the new frame, then refused the sea surface (too large for
+    one grid): the scene was left half in the new frame. Now the surface is checked before anything moves."""
+    doc = tiny()
+    doc["acquisition"]["frames"] = 20
+    doc["vessels"][1]["speed_mps"] = 10.0
+    sim = mmusv.Simulation(doc)
+    sim.set_frame(0)
+    ids = [*np.asarray(sim.ws.vessel_instances).tolist(), *sim.ws.buoy_instances]
+    assert len(sim.ws.buoy_instances) > 0 and sim._buoy_field is not None  # the map's buoys ride the W0 sea
+
+    def poses() -> np.ndarray:
+        return np.array([sim.ws.scene.instance_pose(i) for i in ids])
+
+    before = poses()
+    _refused(lambda: sim.set_frame(19, sea_radius_m=1e5), ConfigError, "sea_radius_m = 100000", "give at most")
+    np.testing.assert_array_equal(poses(), before)
+    sim.set_frame(19)
+    moved = np.abs(poses() - before).max(axis=(1, 2))
+    assert moved[1] > 30.0 and moved[2:].max() > 0.1  # the target sailed 38 m, the buoys near the USV rode the waves
+
+
 _ABORTS = """
 import numpy as np
 import mmusv
