@@ -105,3 +105,12 @@ def test_surface_args_refuse_foci_too_far_apart_before_the_core_allocates() -> N
         surface_args(sea_spec_for_preset("W1"), foci=[[0.0, 0.0], [side, side]], **common)
     with pytest.raises(InputError, match=r"scenario_seed"):
         surface_args(sea_spec_for_preset("W1"), foci=[[0.0, 0.0]], **{**common, "scenario_seed": -1})
+
+
+def test_the_former_home_still_imports_them() -> None:
+    """They lived in ``mmusv.scene`` until 2026-12-07; a user's ``from mmusv.scene import surface_tiles`` works on."""
+    import mmusv.scene
+    import mmusv.sea_surface
+
+    for name in ("MAX_SURFACE_TILES", "SURFACE_TAPER_M", "SURFACE_TILE_M", "surface_taper", "surface_tiles"):
+        assert getattr(mmusv.scene, name) is getattr(mmusv.sea_surface, name), name

@@ -24,7 +24,18 @@ import numpy.typing as npt
 from mmusv import arguments
 from mmusv._native import core
 from mmusv.errors import GeometryError, InputError, NotFoundError
-from mmusv.sea_surface import SeaState, surface_args
+
+# MAX_SURFACE_TILES, SURFACE_TAPER_M, SURFACE_TILE_M, surface_taper and surface_tiles lived here until 2026-12-07
+# and are still importable from here; mmusv.sea_surface is their home.
+from mmusv.sea_surface import (  # noqa: F401
+    MAX_SURFACE_TILES,
+    SURFACE_TAPER_M,
+    SURFACE_TILE_M,
+    SeaState,
+    surface_args,
+    surface_taper,
+    surface_tiles,
+)
 
 __all__ = [
     "NO_HIT",
