@@ -4,7 +4,7 @@ Model: **Marshall–Palmer drops of extinction efficiency 2.** Marshall, J. S. &
 distribution of raindrops with size", *Journal of Meteorology* 5, 165–166: in rain of ``R`` mm/h the drops of
 diameter ``D`` (mm) number ``N(D) = N₀ e^{−ΛD}`` per m³ per mm, ``N₀ = 8000`` m⁻³ mm⁻¹, ``Λ = 4.1 R^−0.21``
 mm⁻¹. A drop is thousands of wavelengths across, so it removes from a beam twice its geometric cross-section
-(the extinction paradox: van de Hulst, H. C. (1957), *Light Scattering by Small Particles*, Wiley, §8.22), and
+(the extinction paradox: van de Hulst, H. C. (1957), *Light Scattering by Small Particles*, Wiley), and
 the rain's extinction coefficient is the closed form
 
     σ_rain = ∫₀^∞ 2 · (π D² / 4) · N₀ e^{−ΛD} dD = π N₀ / Λ³ (mm² m⁻³, ×10⁻⁶ for m⁻¹) ≈ 0.365 · R^0.63 km⁻¹,
