@@ -107,24 +107,26 @@ class Object:
 
 @dataclass(frozen=True)
 class Env:
-    """The environment: unit vector towards the sun (world, z up), turbidity, ground albedo, wind (m/s)."""
+    """The environment: unit vector towards the sun (world, z up), turbidity, ground albedo, wind (m/s), cloud
+    cover (0 clear, Preetham; 1 overcast, the CIE overcast sky, no direct sun)."""
 
     sun: tuple[float, float, float]
     turbidity: float = 3.0
     ground_albedo: float = 0.0
     wind_speed_m_s: float = 0.0
     water_albedo: tuple[float, float, float] = (0.004, 0.018, 0.03)
+    cloud: float = 0.0
 
     def sensor_env(self, *, fog_extinction_per_m: float = 0.0) -> Any:
-        """The mmusv ``SensorEnv``: no cloud, rain or waves, no fog unless ``fog_extinction_per_m`` (1/m), shadows
-        on; the water's single scattering alone (Mitsuba's ``roughconductor`` reflects once; the multiple scattering
-        is checked against its own reference, ``sensors/shade/sea_ms.rs``)."""
+        """The mmusv ``SensorEnv``: the cloud cover ``cloud``, no rain or waves, no fog unless
+        ``fog_extinction_per_m`` (1/m), shadows on; the water's single scattering alone (Mitsuba's ``roughconductor``
+        reflects once; the multiple scattering is checked against its own reference, ``sensors/shade/sea_ms.rs``)."""
         s = np.asarray(self.sun, dtype=np.float64)
         s = s / np.linalg.norm(s)
         return _core.SensorEnv(
             sun_direction=[float(x) for x in s],
             turbidity=self.turbidity,
-            cloud_cover=0.0,
+            cloud_cover=self.cloud,
             ground_albedo=self.ground_albedo,
             fog_extinction_per_m=fog_extinction_per_m,
             rain_mm_per_h=0.0,

@@ -15,6 +15,7 @@
 //! - [`sea`]: exact shortcuts for rays that can only meet the sea surface or the sky (a height bound map).
 //! - [`mesh`]: triangle meshes with per-face semantic classes and a bottom-level BVH built once.
 //! - [`material`]: surface materials (base colour, roughness, metallic, emission) for the cameras' shading.
+//! - [`sky_visibility`]: the sky's visibility over a mesh's own surfaces (ambient occlusion), baked once per mesh.
 //! - [`scene`]: meshes placed as instances, a top-level BVH over them, and batch ray casting over rayon.
 //! - [`export`]: the world triangles at the current poses as PLY or OBJ.
 //! - [`sensors`]: sensor ray patterns (LiDAR sweeps, pinhole cameras), the marine radar and its PPI image.
@@ -100,6 +101,7 @@ pub mod sea;
 pub mod seabed;
 pub mod sensors;
 pub mod simd;
+pub mod sky_visibility;
 pub mod threads;
 
 pub use error::{MmusvError, Result};

@@ -26,6 +26,8 @@ pub struct Mesh {
     /// One block of up to [`BLOCK`] triangles per BVH leaf, by leaf index.
     blocks: Vec<TriBlock>,
     aabb: Aabb,
+    /// A hash of the vertices and faces ([`Mesh::content_key`]).
+    content_key: u64,
 }
 
 /// The closest hit of a ray against one mesh, in the mesh's local frame.
@@ -115,7 +117,31 @@ impl Mesh {
             })
             .collect();
         let aabb = Aabb::from_points(verts.iter().copied());
-        Ok(Self { name, vertices: verts, faces: checked, classes, materials: Vec::new(), triangles, bvh, blocks, aabb })
+        let content_key = {
+            use std::hash::{Hash, Hasher};
+            let mut h = std::hash::DefaultHasher::new();
+            verts.iter().for_each(|v| v.to_array().map(f32::to_bits).hash(&mut h));
+            checked.hash(&mut h);
+            h.finish()
+        };
+        Ok(Self {
+            name,
+            vertices: verts,
+            faces: checked,
+            classes,
+            materials: Vec::new(),
+            triangles,
+            bvh,
+            blocks,
+            aabb,
+            content_key,
+        })
+    }
+
+    /// A 64-bit hash of the vertices and faces: meshes of the same geometry share it (the process-wide caches of
+    /// what depends on the geometry alone, [`crate::sky_visibility::SkyVisibility::shared`]).
+    pub fn content_key(&self) -> u64 {
+        self.content_key
     }
 
     /// The mesh's name (free text, used in exports and errors).

@@ -77,7 +77,7 @@ pub enum Quality {
     Draft,
     /// Traced water reflections, one per 2 × 2 block of water pixels (4 × 4 where the water's glossy lobe spans
     /// many such blocks), each in a direction drawn from that lobe and spread over the rest of it; 4 stratified
-    /// samples on edge pixels.
+    /// samples on edge pixels; the sky's light hidden from a mesh's recesses by the mesh itself (also at `high`).
     #[default]
     Standard,
     /// Traced water reflections for every pixel; 16 stratified samples on edge pixels.
@@ -99,6 +99,11 @@ impl Quality {
     }
     /// Whether the water shows the vessels' Kelvin waves (`shade/kelvin.rs`; `draft` draws their foam only).
     pub fn kelvin_waves(self) -> bool {
+        !matches!(self, Quality::Draft)
+    }
+    /// Whether a mesh's own surfaces hide the sky's light from its recesses ([`crate::sky_visibility`]; `draft`
+    /// lights every surface with the whole sky).
+    pub fn sky_visibility(self) -> bool {
         !matches!(self, Quality::Draft)
     }
 }
@@ -441,6 +446,7 @@ impl Camera {
         let shader = Shader::new(env, options.seed, options.wakes)
             .with_kelvin_waves(q.kelvin_waves())
             .with_materials(scene.material_table())
+            .with_sky_visibility_if(q.sky_visibility(), scene)
             .with_lamps(scene)
             .with_seabed(scene.seabed())
             .with_waves(scene.wave_surface())

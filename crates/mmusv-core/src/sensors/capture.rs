@@ -18,6 +18,7 @@ use super::shade::ShadeEnv;
 use crate::error::Result;
 use crate::geometry::RigidPose;
 use crate::scene::Scene;
+use crate::sky_visibility::SkyVisibility;
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -146,6 +147,15 @@ pub fn capture_frame(
     wakes: &[Wake],
     tasks: &[SensorTask<'_>],
 ) -> Result<Vec<TaskResult>> {
+    // The meshes' sky visibility, baked here once (each mesh's samples in parallel) rather than by the first
+    // cameras at once, each baking it.
+    let shaded = |t: &SensorTask<'_>| match *t {
+        SensorTask::Camera { camera, rgb, .. } => rgb && camera.config().image.quality.sky_visibility(),
+        _ => false,
+    };
+    if tasks.iter().any(shaded) {
+        SkyVisibility::prepare(scene);
+    }
     tasks.par_iter().with_max_len(1).map(|task| run_task(scene, env, wakes, task)).collect()
 }
 

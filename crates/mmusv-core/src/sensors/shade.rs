@@ -22,9 +22,12 @@
 //!
 //! A surface of material `m` seen along `d` (`v = −d`) is lit by the sun (irradiance `E_s` along `s`, when the
 //! camera's shadow ray finds it unoccluded) and by the environment:
-//! `L = L_e + (f_d + f_s(v, s)) E_s (n·s) + f_d E_env(n) + P(r', roughness) (F0 A + B)`, with `f_d = (1 − metallic)
-//! base / π` and `r'` the rough lobe's dominant direction (Lagarde & de Rousiers 2014). The environment light is
-//! not occluded (no ambient occlusion): every surface sees the whole sky and the sea, a known limit of the model.
+//! `L = L_e + (f_d + f_s(v, s)) E_s (n·s) + f_d (V_sky E_sky(n) + V_ground E_ground(n)) + P(r', roughness)
+//! (F0 A + B) S`, with `f_d = (1 − metallic) base / π`, `r'` the rough lobe's dominant direction (Lagarde & de
+//! Rousiers 2014), `E_sky` and `E_ground` the environment's irradiance from above and below the horizon, `V_sky` and
+//! `V_ground` the shares of them that the surface's own mesh leaves it and `S` the specular occlusion of the part
+//! `r'` leans into ([`crate::sky_visibility`]; 1 at `draft` quality). Other instances do not occlude the
+//! environment's light (a ship's side beside a quay sees the whole sky), a known limit of the model.
 //! At night each lit navigation lamp adds its light the same way as the sun, `(f_d + f_s(v, l)) E_l (n·l)` behind a
 //! shadow ray ([`lamp_light`]; the camera adds it to the rays it shades, `camera/lamp_light.rs`).
 //! Water is a dielectric (IOR 1.33) whose normals and roughness come from the wave surface where the scene has one
@@ -37,8 +40,10 @@
 
 use super::noise::{self, stream};
 use crate::material::Material;
+use crate::scene::Scene;
 use crate::sea::WaveSurface;
 use crate::seabed::Seabed;
+use crate::sky_visibility::{specular_occlusion, wants_sky_visibility, SkyVisibility};
 use parry3d::math::Vec3;
 use std::sync::Arc;
 
@@ -107,6 +112,8 @@ pub struct Shader {
     pixel_m: f32,
     /// The lit navigation lamps whose glitter and direct light the camera samples ([`Shader::with_lamps`]).
     lamps: Arc<lamp_glitter::LampSet>,
+    /// Per scene mesh, the sky's visibility over its own surfaces ([`Shader::with_sky_visibility`]); empty: none.
+    sky_visibility: Vec<Option<Arc<SkyVisibility>>>,
 }
 
 impl Shader {
@@ -138,6 +145,7 @@ impl Shader {
             pixel_rad: 0.0,
             pixel_m: 0.0,
             lamps: Arc::default(),
+            sky_visibility: Vec::new(),
         }
     }
 
@@ -201,6 +209,43 @@ impl Shader {
     pub fn with_materials(mut self, table: Arc<Vec<Material>>) -> Self {
         self.materials = table;
         self
+    }
+
+    /// Darkens the environment's light where a mesh hides the sky from its own surfaces
+    /// ([`crate::sky_visibility`]): each of `scene`'s meshes but the water's, baked on first use in the process.
+    pub fn with_sky_visibility(mut self, scene: &Scene) -> Self {
+        self.sky_visibility =
+            scene.meshes().iter().map(|m| wants_sky_visibility(m).then(|| SkyVisibility::shared(m))).collect();
+        self
+    }
+
+    /// [`Shader::with_sky_visibility`] when `on` (the cameras' `standard` and `high` qualities), else unchanged.
+    pub fn with_sky_visibility_if(self, on: bool, scene: &Scene) -> Self {
+        if on {
+            self.with_sky_visibility(scene)
+        } else {
+            self
+        }
+    }
+
+    /// `[V_sky, V_ground]`, the sky's and the ground's visibility at world point `point` on triangle `triangle` of
+    /// instance `instance` of `scene` (the scene of [`Shader::with_sky_visibility`]); `[1, 1]` without it.
+    #[inline]
+    pub fn sky_visibility(&self, scene: &Scene, instance: i32, triangle: i32, point: Vec3) -> [f32; 2] {
+        if self.sky_visibility.is_empty() {
+            return [1.0; 2];
+        }
+        let (Ok(i), Ok(t)) = (usize::try_from(instance), u32::try_from(triangle)) else {
+            return [1.0; 2];
+        };
+        let Some(inst) = scene.instances().get(i) else {
+            return [1.0; 2];
+        };
+        let m = inst.mesh() as usize;
+        match (self.sky_visibility.get(m), scene.meshes().get(m)) {
+            (Some(Some(v)), Some(mesh)) => v.at(mesh, t, inst.pose().inverse_transform_point(point)),
+            _ => [1.0; 2],
+        }
     }
 
     /// The lighting (sky, sun, image-based light).
@@ -308,14 +353,21 @@ impl Shader {
         let nv = n.dot(v).max(1e-4);
         let lobes = Lobes::of(&m);
         let Lobes { diffuse, f0, alpha } = lobes;
-        let mut c = diffuse * self.light.irradiance(n);
+        // The environment's light, less what the surface's own mesh hides of the sky's and of the ground's
+        // (`sky_visibility.rs`).
+        let [v_sky, v_ground] = hit.sky_visibility;
+        let e_ground = self.light.ground_irradiance(n);
+        let mut c = diffuse * ((self.light.irradiance(n) - e_ground) * v_sky + e_ground * v_ground);
         let r = d - n * (2.0 * d.dot(n));
         // The rough lobe's dominant direction leans from the mirror direction towards the normal (Lagarde & de
         // Rousiers 2014, "Moving Frostbite to PBR", section 4.9.3), where the split sum reads the environment.
         let lean = (1.0 - alpha) * ((1.0 - alpha).sqrt() + alpha);
         let dominant = (n + (r - n) * lean).normalize_or(r);
         let [a, b] = dfg(nv, m.roughness);
-        c += self.light.prefiltered(dominant, m.roughness) * (f0 * a + Vec3::splat(b));
+        let v_lobe = if dominant.z >= 0.0 { v_sky } else { v_ground };
+        c += self.light.prefiltered(dominant, m.roughness)
+            * (f0 * a + Vec3::splat(b))
+            * specular_occlusion(nv, v_lobe, alpha);
         if sunlit {
             c += lobes.direct(n, v, self.sun, self.sun_e);
         }

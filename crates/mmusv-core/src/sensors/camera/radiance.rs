@@ -52,6 +52,11 @@ pub(crate) fn surface_at(
         lights_on: lamp_lit(scene, shader, instance, material, d),
         shading_normal: normal,
         unresolved_mss: 0.0,
+        sky_visibility: if hits.class[k] == 1 || hits.backface[k] {
+            [1.0; 2]
+        } else {
+            shader.sky_visibility(scene, instance, triangle, point)
+        },
     };
     Some(shader.with_swell(d, hit))
 }

@@ -89,6 +89,10 @@ pub struct SurfaceHit {
     /// For water on the displaced sea, the mean square slope of the waves too short for the surface's sampling
     /// there ([`crate::sea::SurfaceShading`]), added to the glint's roughness; 0 elsewhere.
     pub unresolved_mss: f32,
+    /// `[V_sky, V_ground]`: the share of the sky's and of the ground's light that the hit's own mesh leaves it
+    /// ([`crate::sky_visibility`]), scaling the environment's light on it; `[1, 1]` for water, a back face, or a
+    /// render without it.
+    pub sky_visibility: [f32; 2],
 }
 
 impl SurfaceHit {

@@ -385,6 +385,12 @@ impl Lighting {
         read(&self.irradiance, n)
     }
 
+    /// The part of [`Lighting::irradiance`] that comes from the uniform ground below the horizon (lux, linear RGB).
+    #[inline(always)]
+    pub fn ground_irradiance(&self, n: Vec3) -> Vec3 {
+        self.ground * ground_share(n)
+    }
+
     /// GGX-prefiltered environment radiance around the mirror direction `r` for perceptual `roughness`.
     #[inline(always)]
     pub fn prefiltered(&self, r: Vec3, roughness: f32) -> Vec3 {

@@ -202,6 +202,7 @@ mod tests {
             lights_on: false,
             shading_normal: Vec3::Z,
             unresolved_mss: 0.0,
+            sky_visibility: [1.0; 2],
         }
     }
 

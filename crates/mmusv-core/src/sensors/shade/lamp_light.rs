@@ -111,6 +111,7 @@ mod tests {
             lights_on: false,
             shading_normal: normal,
             unresolved_mss: 0.0,
+            sky_visibility: [1.0; 2],
         }
     }
 

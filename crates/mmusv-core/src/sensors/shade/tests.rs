@@ -14,6 +14,7 @@ fn hit(class: u16, material: u16) -> SurfaceHit {
         lights_on: false,
         shading_normal: Vec3::Z,
         unresolved_mss: 0.0,
+        sky_visibility: [1.0; 2],
     }
 }
 
