@@ -363,27 +363,6 @@ pub fn specular_occlusion(nv: f32, v: f32, alpha: f32) -> f32 {
 mod tests {
     use super::*;
 
-    /// An axis-aligned box from `lo` to `hi`, faces wound outwards.
-    fn cuboid(lo: [f32; 3], hi: [f32; 3]) -> (Vec<[f32; 3]>, Vec<[i64; 3]>) {
-        let v =
-            (0..8).map(|i| [[lo[0], hi[0]][i & 1], [lo[1], hi[1]][i >> 1 & 1], [lo[2], hi[2]][i >> 2 & 1]]).collect();
-        let f = vec![
-            [0, 2, 1],
-            [1, 2, 3],
-            [4, 5, 6],
-            [5, 7, 6],
-            [0, 1, 4],
-            [1, 5, 4],
-            [2, 6, 3],
-            [3, 6, 7],
-            [0, 4, 2],
-            [2, 4, 6],
-            [1, 3, 5],
-            [3, 7, 5],
-        ];
-        (v, f)
-    }
-
     fn mesh(v: &[[f32; 3]], f: &[[i64; 3]]) -> Mesh {
         Mesh::new("m", v, f, &[2]).unwrap_or_else(|e| unreachable!("{e}"))
     }
@@ -406,8 +385,7 @@ mod tests {
 
     #[test]
     fn a_convex_mesh_sees_the_whole_sky_everywhere() {
-        let (v, f) = cuboid([-10.0, -3.0, -1.0], [10.0, 3.0, 4.0]);
-        let sky = SkyVisibility::bake(&mesh(&v, &f));
+        let sky = SkyVisibility::bake(&crate::scene::tests::box_mesh([10.0, 3.0, 2.5], 2));
         assert!(sky.num_samples() > 12);
         assert!(sky.values().iter().all(|&x| x == [1.0; 2]), "{:?}", sky.values());
     }
