@@ -86,3 +86,47 @@ fn water_reflects_by_fresnel() {
     let graze = sh.water(g, &wg, false, Some(bright)) - sh.water(g, &wg, false, Some(Vec3::ZERO));
     assert!(graze.x > 5.0 * down.x);
 }
+
+#[test]
+fn the_sky_and_the_ground_a_mesh_hides_scale_their_own_light() {
+    // A rough grey wall and floor in the shade (no sun, no emission): the environment's light alone. Each part of
+    // the hemisphere scales its own irradiance: the floor (normal up) sees no ground, so V_ground does nothing to
+    // it; a face looking straight down sees no sky, so V_sky does nothing to its diffuse light; with both parts
+    // hidden nothing is left (the specular too: its occlusion is 0 when V is); with neither, the shading of before.
+    let env = ShadeEnv { fog_extinction_per_m: 0.0, ground_albedo: 0.3, ..ShadeEnv::default() };
+    let m = Material {
+        base_color: [0.5; 3],
+        roughness: 1.0,
+        metallic: 0.0,
+        emissive: [0.0; 3],
+        nav_light: false,
+        arc_deg: [0.0, 180.0],
+    };
+    let sh = Shader::new(&env, 1, &[]).with_materials(table(m));
+    let shade = |n: Vec3, v: [f32; 2]| {
+        let h = SurfaceHit { normal: n, shading_normal: n, sky_visibility: v, ..hit(2, 1) };
+        sh.surface(-n, &h, false)
+    };
+    let up = Vec3::Z;
+    assert_eq!(shade(up, [0.4, 0.0]), shade(up, [0.4, 1.0]));
+    assert!(shade(up, [0.4, 1.0]).y < 0.5 * shade(up, [1.0, 1.0]).y);
+    let side = Vec3::X;
+    let both = shade(side, [1.0, 1.0]);
+    assert_eq!(shade(side, [0.0, 0.0]), Vec3::ZERO);
+    // The wall's diffuse light splits into the sky's and the ground's parts, each scaled by its own share; its
+    // specular light (seen along its normal, the lobe leans into neither part: the sky's share counts) goes with
+    // the sky's.
+    let e = sh.lighting().irradiance(side);
+    let g = sh.lighting().ground_irradiance(side);
+    assert!(g.y > 0.0 && g.y < e.y, "{g} {e}");
+    let diffuse = Vec3::splat(0.5 / std::f32::consts::PI);
+    let specular = both - diffuse * e;
+    assert!(specular.y > 0.0 && specular.y < 0.1 * both.y, "{specular}");
+    let no_ground = shade(side, [1.0, 0.0]);
+    let no_sky = shade(side, [0.0, 1.0]);
+    assert!((no_ground - (diffuse * (e - g) + specular)).length() < 1e-3 * both.length(), "{no_ground}");
+    assert!((no_sky - diffuse * g).length() < 1e-3 * both.length(), "{no_sky}");
+    let down = -Vec3::Z;
+    let d_sky = shade(down, [0.0, 1.0]) - shade(down, [1.0, 1.0]);
+    assert!(d_sky.length() < 1e-3 * shade(down, [1.0, 1.0]).length(), "{d_sky}");
+}
