@@ -18,6 +18,18 @@ fn hit(class: u16, material: u16) -> SurfaceHit {
     }
 }
 
+/// A rough grey dielectric: base colour 0.5, roughness 1 (nearly Lambertian), no emission.
+fn rough_grey() -> Material {
+    Material {
+        base_color: [0.5; 3],
+        roughness: 1.0,
+        metallic: 0.0,
+        emissive: [0.0; 3],
+        nav_light: false,
+        arc_deg: [0.0, 180.0],
+    }
+}
+
 /// A table whose material 1 is `m`.
 fn table(m: Material) -> Arc<Vec<Material>> {
     Arc::new(vec![m, m])
@@ -26,15 +38,7 @@ fn table(m: Material) -> Arc<Vec<Material>> {
 #[test]
 fn lambert_plane_under_the_sun_is_albedo_times_irradiance_over_pi() {
     let env = ShadeEnv { fog_extinction_per_m: 0.0, ..ShadeEnv::default() };
-    let m = Material {
-        base_color: [0.5; 3],
-        roughness: 1.0,
-        metallic: 0.0,
-        emissive: [0.0; 3],
-        nav_light: false,
-        arc_deg: [0.0, 180.0],
-    };
-    let sh = Shader::new(&env, 1, &[]).with_materials(table(m));
+    let sh = Shader::new(&env, 1, &[]).with_materials(table(rough_grey()));
     // The specular part of a rough dielectric is small; compare the diffuse share in closed form.
     let lit = sh.surface(-Vec3::Z, &hit(2, 1), true);
     let dark = sh.surface(-Vec3::Z, &hit(2, 1), false);
@@ -94,15 +98,7 @@ fn the_sky_and_the_ground_a_mesh_hides_scale_their_own_light() {
     // it; a face looking straight down sees no sky, so V_sky does nothing to its diffuse light; with both parts
     // hidden nothing is left (the specular too: its occlusion is 0 when V is); with neither, the shading of before.
     let env = ShadeEnv { fog_extinction_per_m: 0.0, ground_albedo: 0.3, ..ShadeEnv::default() };
-    let m = Material {
-        base_color: [0.5; 3],
-        roughness: 1.0,
-        metallic: 0.0,
-        emissive: [0.0; 3],
-        nav_light: false,
-        arc_deg: [0.0, 180.0],
-    };
-    let sh = Shader::new(&env, 1, &[]).with_materials(table(m));
+    let sh = Shader::new(&env, 1, &[]).with_materials(table(rough_grey()));
     let shade = |n: Vec3, v: [f32; 2]| {
         let h = SurfaceHit { normal: n, shading_normal: n, sky_visibility: v, ..hit(2, 1) };
         sh.surface(-n, &h, false)
