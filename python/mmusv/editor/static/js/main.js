@@ -392,7 +392,16 @@ async function preview() {
   }
 }
 
+/** Whether `job` is an older word on the run shown than the one shown: replies come back out of order (the stop's
+ * reply is the run as it was when the stop came, still running; a slow poll's reply is older than the next one's).
+ * One coming after the poll that saw the run end put it back to running, and nothing polled it again. */
+function stale(job) {
+  if (!currentRun || currentRun.id !== job.id || job.status !== "running") return false;
+  return currentRun.status !== "running" || job.done < currentRun.done;
+}
+
 function showRun(job) {
+  if (stale(job)) return;
   currentRun = job;
   const box = $("run-status");
   box.hidden = false;

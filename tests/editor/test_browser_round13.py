@@ -1,0 +1,69 @@
+"""A thirteenth round through the editor in a real headless Chromium: the replies about a run can come back out of
+order. The stop's reply is the run as it was when the stop was sent (still running), and a slow poll's reply can be
+older than the next poll's. Either one, coming after the poll that saw the run end, put the run back to "running"
+with its Stop button, and nothing polled it again: the page showed a stopped run as running for good. CI saw
+``test_an_interrupted_run_is_told_as_an_error`` wait 60 s for the stop. A run that has ended now stays ended, and
+its progress never goes back.
+
+Each browser test checks the browser's console for JavaScript errors (failed requests the page explains are not
+errors).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import pytest
+from selenium.webdriver.common.by import By
+from selenium.webdriver.support.select import Select
+from test_browser import LiveServer, _wait, open_editor, settled
+from test_browser_round import js_errors, type_into
+from test_browser_round2 import save_as
+
+ENDED = "return document.getElementById('run-status').dataset.status === 'interrupted'"
+
+# The reply to the first request that `late` picks is held until the page shows the run ended, then given to the
+# page; `window.lateDelivered` says when the page has it.
+HOLD_ONE_REPLY = """const real = window.fetch, late = arguments[0];
+let held = false;
+window.lateDelivered = false;
+window.fetch = async (url, opts) => {
+  const res = await real(url, opts);
+  const method = (opts && opts.method) || 'GET';
+  if (!held && method === late && /\\/api\\/runs\\/\\d+$/.test(String(url))) {
+    held = true;
+    while (document.getElementById('run-status').dataset.status !== 'interrupted') {
+      await new Promise((r) => setTimeout(r, 50));
+    }
+    setTimeout(() => { window.lateDelivered = true; }, 300);
+  }
+  return res;
+};"""
+
+
+@pytest.mark.parametrize("late", ["DELETE", "GET"], ids=["the stop's reply", "a poll's reply"])
+def test_a_reply_older_than_the_run_s_end_does_not_start_it_again(
+    browser: Any, live_server: LiveServer, late: str
+) -> None:
+    open_editor(browser, live_server)
+    js_errors(browser)
+    preset = '#rigs [data-rig="usv_standard"] select[data-key="preset"]'
+    Select(browser.find_element(By.CSS_SELECTOR, preset)).select_by_value("lidar_only")
+    type_into(browser, browser.find_element(By.ID, "a-frames"), "200")  # a run long enough to stop (40 s sailed)
+    settled(browser)
+    save_as(browser, f"late_{late.lower()}.yaml")  # a file of its own: the folder is the module's
+    type_into(browser, browser.find_element(By.ID, "run-frames"), "")
+    browser.execute_script(HOLD_ONE_REPLY, late)
+    browser.find_element(By.ID, "run").click()
+    _wait(browser, "return document.getElementById('run-status').dataset.status === 'running'", "the run")
+    if late == "GET":  # the first poll's reply is the one held: it must be asked for before the stop
+        _wait(browser, "return document.getElementById('run-text').textContent.startsWith('running')", "a poll")
+        browser.execute_script("return new Promise((r) => setTimeout(r, 500))")
+    browser.find_element(By.ID, "run-stop").click()
+    _wait(browser, ENDED, "the stop")
+    _wait(browser, "return window.lateDelivered", "the late reply")
+    # was: "running · frame 0", the Stop button shown, and no poll left to correct it
+    assert browser.execute_script(ENDED)
+    assert browser.find_element(By.ID, "run-text").text.startswith("interrupted: ")
+    assert not browser.find_element(By.ID, "run-stop").is_displayed()
+    assert js_errors(browser) == []
