@@ -18,8 +18,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-from collections.abc import Callable
-from typing import Any
 
 from mmusv import cli_console
 from mmusv.cli_library import cmd_assets, cmd_scenarios
@@ -29,63 +27,7 @@ from mmusv.cli_recordings import cmd_info, cmd_preview, cmd_recover
 from mmusv.cli_run import cmd_run
 from mmusv.cli_schema import cmd_schema
 from mmusv.errors import MmusvError
-from mmusv.held_signals import forget_handled_interrupt, note_stop
-
-
-class _Signals:
-    """While a command runs: SIGTERM (a ``kill``, a service manager) and SIGINT (Ctrl-C) both end it the way
-    Ctrl-C always did — raised as ``KeyboardInterrupt`` in the main thread, so the current frame is finished or
-    abandoned, files are closed and background jobs are stopped — and the command ends with one line, ``mmusv:
-    interrupted`` (``mmusv: terminated (SIGTERM)``), and the exit status 128 + the signal's number: also where a
-    library swallowed the ``KeyboardInterrupt`` in the command's last step or made an error of its own of it. The
-    previous handlers come back afterwards (``main`` may be called in-process)."""
-
-    SIGNALS = ("SIGINT", "SIGTERM")
-
-    def __init__(self) -> None:
-        self.received: int | None = None
-        self.said = False  # the command's stop was said (:func:`_stopped`)
-        self._old: dict[int, object] = {}
-        self._hook: Callable[[Any], object] = sys.unraisablehook
-
-    def _handle(self, signum: int, frame: object) -> None:
-        if self.received is None:
-            self.received = signum
-        note_stop(signum)  # raised again by long loops where a library swallows this KeyboardInterrupt
-        raise KeyboardInterrupt
-
-    def _unraisable(self, unraisable: Any) -> None:
-        # The KeyboardInterrupt this handler raised where Python cannot propagate it (importlib's module-lock
-        # callback, a finalizer) was reported as "Exception ignored in ..." with a traceback; the stop is noted and
-        # raised again by the long loops (held_signals.raise_noted_stop), so it is not reported.
-        if self.received is not None and isinstance(unraisable.exc_value, KeyboardInterrupt):
-            return
-        self._hook(unraisable)
-
-    def __enter__(self) -> _Signals:
-        import signal
-        import threading
-
-        if threading.current_thread() is threading.main_thread():
-            for name in self.SIGNALS:
-                num = getattr(signal, name, None)
-                if num is not None:
-                    self._old[num] = signal.signal(num, self._handle)
-            self._hook, sys.unraisablehook = sys.unraisablehook, self._unraisable
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        import signal
-
-        for num, old in self._old.items():
-            signal.signal(num, old)  # type: ignore[arg-type]
-        if self._old:
-            sys.unraisablehook = self._hook
-        note_stop(None)
-
-    def status(self, default: int) -> int:
-        """128 + the signal received, else ``default``."""
-        return default if self.received is None else 128 + self.received
+from mmusv.held_signals import StopSignals, forget_handled_interrupt
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -123,7 +65,7 @@ def _main(argv: list[str] | None) -> int:
 
 def _run_command(args: argparse.Namespace) -> int:
     """:func:`_dispatch` of ``args`` with the command line's signal handling and one-line errors."""
-    with _Signals() as signals:
+    with StopSignals() as signals:
         try:
             cli_console.check_thread_environment()  # before the core's or Polars' thread pools exist
             code = _dispatch(args)
@@ -168,9 +110,9 @@ def _run_command(args: argparse.Namespace) -> int:
     return signals.status(code)
 
 
-def _stopped(signals: _Signals) -> int:
+def _stopped(signals: StopSignals) -> int:
     """Says that the command was stopped (``mmusv: interrupted``, or ``terminated (SIGTERM)``), once; returns 130,
-    which :meth:`_Signals.status` makes 128 + the signal received."""
+    which :meth:`StopSignals.status` makes 128 + the signal received."""
     name = "terminated (SIGTERM)" if signals.received not in (None, 2) else "interrupted"
     cli_console.say(f"mmusv: {name}")
     signals.said = True

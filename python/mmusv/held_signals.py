@@ -1,6 +1,7 @@
 """Holding SIGINT and SIGTERM back while steps run that a stop must not split (:class:`HeldSignals`): a
 recording opened and its metadata written (:mod:`mmusv.recording.guard`), the ``mmusv`` command's modules loaded
-(:mod:`mmusv._launch`). And the stop the ``mmusv`` command's handler (or its batch's pool worker's) noted
+(:mod:`mmusv._launch`), the editor's run process's (:mod:`mmusv.editor.job`). And the stop the ``mmusv`` command's
+handler (:class:`StopSignals`, also the editor's run process's; or its batch's pool worker's) noted
 (:func:`note_stop`), for the work to end as a stop where a library met its ``KeyboardInterrupt``: raised again
 where the library swallowed it (:func:`raise_noted_stop`), and where the library made an error of its own of it,
 that error taken for the stop (:func:`is_stop`, :func:`stops_unwrapped`). A module of its own, light to import:
@@ -9,10 +10,20 @@ the command holds the signals before it loads the rest of mmusv.
 
 from __future__ import annotations
 
+import sys
+from collections.abc import Callable
 from types import TracebackType
 from typing import Any
 
-__all__ = ["HeldSignals", "forget_handled_interrupt", "is_stop", "note_stop", "raise_noted_stop", "stops_unwrapped"]
+__all__ = [
+    "HeldSignals",
+    "StopSignals",
+    "forget_handled_interrupt",
+    "is_stop",
+    "note_stop",
+    "raise_noted_stop",
+    "stops_unwrapped",
+]
 
 _stop: list[int] = []
 """The stop the ``mmusv`` command's handler noted (at most one signal number; :func:`note_stop`)."""
@@ -107,8 +118,8 @@ def note_stop(signum: int | None) -> None:
     """Notes (or, with ``None``, forgets) the stop the ``mmusv`` command's signal handler received, before it
     raises ``KeyboardInterrupt``: :func:`raise_noted_stop` raises it again where a library swallowed it, and
     :func:`stops_unwrapped` where a library wrapped it in an error of its own. Only the command notes stops (its
-    handler, ``mmusv.cli``, and that of its batch's pool workers, ``mmusv.batch.executors``): called from Python,
-    mmusv's functions see no noted stop and are unchanged."""
+    handler, :class:`StopSignals`, which the editor's run process uses too, and that of its batch's pool workers,
+    ``mmusv.batch.executors``): called from Python, mmusv's functions see no noted stop and are unchanged."""
     _stop[:] = [] if signum is None else [signum]
 
 
@@ -157,3 +168,60 @@ def stops_unwrapped() -> _StopsUnwrapped:
     recorded as the stop it is (``status: interrupted``, as for a plain Ctrl-C). The command itself ends any error
     after a stop as the stop (``mmusv.cli``)."""
     return _StopsUnwrapped()
+
+
+class StopSignals:
+    """While a command runs (``mmusv``, :mod:`mmusv.cli`; a run the editor started, :mod:`mmusv.editor.job`): SIGTERM
+    (a ``kill``, a service manager) and SIGINT (Ctrl-C, the editor's Stop) both end it the way Ctrl-C always did —
+    raised as ``KeyboardInterrupt`` in the main thread, so the current frame is finished or abandoned, files are
+    closed and background jobs are stopped — and the stop is noted (:func:`note_stop`) for the work to end as a stop
+    also where a library swallowed the ``KeyboardInterrupt`` or made an error of its own of it. ``received`` is the
+    first signal; the caller ends with one word of the stop (``said``) and the exit status 128 + the signal's number
+    (:meth:`status`). The previous handlers come back afterwards (the caller may run in a process that goes on)."""
+
+    SIGNALS = ("SIGINT", "SIGTERM")
+
+    def __init__(self) -> None:
+        self.received: int | None = None
+        self.said = False  # the caller said the stop (the command's ``mmusv: interrupted``)
+        self._old: dict[int, object] = {}
+        self._hook: Callable[[Any], object] = sys.unraisablehook
+
+    def _handle(self, signum: int, frame: object) -> None:
+        if self.received is None:
+            self.received = signum
+        note_stop(signum)  # raised again by long loops where a library swallows this KeyboardInterrupt
+        raise KeyboardInterrupt
+
+    def _unraisable(self, unraisable: Any) -> None:
+        # The KeyboardInterrupt this handler raised where Python cannot propagate it (importlib's module-lock
+        # callback, a finalizer) was reported as "Exception ignored in ..." with a traceback; the stop is noted and
+        # raised again by the long loops (held_signals.raise_noted_stop), so it is not reported.
+        if self.received is not None and isinstance(unraisable.exc_value, KeyboardInterrupt):
+            return
+        self._hook(unraisable)
+
+    def __enter__(self) -> StopSignals:
+        import signal
+        import threading
+
+        if threading.current_thread() is threading.main_thread():
+            for name in self.SIGNALS:
+                num = getattr(signal, name, None)
+                if num is not None:
+                    self._old[num] = signal.signal(num, self._handle)
+            self._hook, sys.unraisablehook = sys.unraisablehook, self._unraisable
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        import signal
+
+        for num, old in self._old.items():
+            signal.signal(num, old)  # type: ignore[arg-type]
+        if self._old:
+            sys.unraisablehook = self._hook
+        note_stop(None)
+
+    def status(self, default: int) -> int:
+        """128 + the signal received, else ``default``."""
+        return default if self.received is None else 128 + self.received

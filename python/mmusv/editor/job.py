@@ -7,7 +7,8 @@ and last ``{"status": "complete", "frames": k, "recording": path, "seconds": s}`
 ends a line the stop may have cut short; exit status 130; the
 recording then holds every completed frame, and the line names it and its frames as for a complete run). A stop
 that comes once every frame is written changes nothing: the line says ``complete`` (exit status 0), as the recording
-and its manifest do.
+and its manifest do. The stop is handled as ``mmusv run`` handles it (:mod:`mmusv.held_signals`): held while the run's
+modules load, and noted, so that a stop a library swallows or makes an error of its own ends the run as a stop.
 """
 
 from __future__ import annotations
@@ -62,28 +63,61 @@ def main(argv: list[str] | None = None) -> int:
         _say({"warning": str(message)})
 
     warnings.showwarning = _warn
-    try:  # imports inside: a stop (SIGINT) while they load still ends with a status line
+    from mmusv.held_signals import HeldSignals, StopSignals, forget_handled_interrupt
+
+    # A stop while the run's modules load is held to the end of the load, not raised inside it: a library's
+    # ``except`` around an optional import swallowed it, and the run went on to its last frame.
+    held = HeldSignals().hold()
+    try:
         from mmusv.acquire import run
         from mmusv.errors import MmusvError
-    except KeyboardInterrupt:
+    except KeyboardInterrupt:  # before the hold (Python's own start) or a handler outside Python
+        noted: int | None = signal.SIGINT
+    else:
+        noted = None
+    finally:
+        noted_while_held = held.release(hand_on=False)
+    noted = noted or noted_while_held
+    if noted is not None:
         _say({"status": "interrupted", "error": "stopped before the first frame"})
-        return 130
-    try:
-        res = run(
-            args.scenario,
-            out_dir=args.output,
-            overwrite=True,
-            frames=args.frames,
-            progress=lambda done, total: _say({"done": done, "total": total}),
-        )
-        # The run is over: a stop from here on (the editor's button pressed as it ended) is too late to change it.
-        # It ended the process with a traceback before the status line, and the editor then said "stopped before
-        # the first frame" of a complete run.
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
-    except MmusvError as exc:
-        _say({"status": "failed", "error": str(exc)})
-        return 2
-    except KeyboardInterrupt:
+        forget_handled_interrupt()
+        return 128 + noted
+    # The stop is noted as ``mmusv run`` notes it (held_signals): raised again at the next frame where a library
+    # swallowed its KeyboardInterrupt (the run went on to its last frame and said "complete"), and an error a library
+    # made of it is the stop (a traceback, no status line: "the run process ended with status 1").
+    with StopSignals() as stops:
+        try:
+            res = run(
+                args.scenario,
+                out_dir=args.output,
+                overwrite=True,
+                frames=args.frames,
+                progress=lambda done, total: _say({"done": done, "total": total}),
+            )
+        except KeyboardInterrupt:
+            pass
+        except MmusvError as exc:
+            if stops.received is None:
+                _say({"status": "failed", "error": str(exc)})
+                return 2
+        except Exception:
+            if stops.received is None:
+                raise
+        else:
+            # The run is over: a stop from here on (the editor's button pressed as it ended, or one a library
+            # swallowed in the last frame) is too late to change it. It ended the process with a traceback before
+            # the status line, and the editor then said "stopped before the first frame" of a complete run.
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+            _say(
+                {
+                    "status": res.status,
+                    "frames": res.frames_written,
+                    "recording": str(res.recording),
+                    "seconds": round(res.seconds, 3),
+                }
+            )
+            forget_handled_interrupt()
+            return 0
         signal.signal(signal.SIGINT, signal.SIG_IGN)  # a second stop would cut the status line
         kept = _kept(args)
         if kept.get("status") == "complete":  # every frame was written before the stop came
@@ -93,16 +127,8 @@ def main(argv: list[str] | None = None) -> int:
         # A newline first ends any line the stop cut short (the editor passes an empty line over).
         sys.stdout.write("\n")
         _say({"status": "interrupted", "error": "stopped; the recording holds every completed frame", **kept})
-        return 130
-    _say(
-        {
-            "status": res.status,
-            "frames": res.frames_written,
-            "recording": str(res.recording),
-            "seconds": round(res.seconds, 3),
-        }
-    )
-    return 0
+        forget_handled_interrupt()
+        return 128 + (stops.received or signal.SIGINT)
 
 
 if __name__ == "__main__":
