@@ -3,7 +3,8 @@ order. The stop's reply is the run as it was when the stop was sent (still runni
 older than the next poll's. Either one, coming after the poll that saw the run end, put the run back to "running"
 with its Stop button, and nothing polled it again: the page showed a stopped run as running for good. CI saw
 ``test_an_interrupted_run_is_told_as_an_error`` wait 60 s for the stop. A run that has ended now stays ended, and
-its progress never goes back.
+its progress never goes back. The preview had the same fault: a preview closed and asked again for another frame
+showed the first one's picture if it came in last; a reply is now shown only if it is the last asked for.
 
 Each browser test checks the browser's console for JavaScript errors (failed requests the page explains are not
 errors).
@@ -66,4 +67,47 @@ def test_a_reply_older_than_the_run_s_end_does_not_start_it_again(
     assert browser.execute_script(ENDED)
     assert browser.find_element(By.ID, "run-text").text.startswith("interrupted: ")
     assert not browser.find_element(By.ID, "run-stop").is_displayed()
+    assert js_errors(browser) == []
+
+
+# The reply to the first preview asked for is held until a picture is shown (the second's: the first's is held), and
+# then given to the page as a 1 x 1 picture (so that the page's picture tells whose reply it shows). The server may
+# answer the second first.
+HOLD_FIRST_PREVIEW = """const real = window.fetch;
+let previews = 0;
+window.firstDelivered = false;
+window.fetch = async (url, opts) => {
+  const first = String(url).endsWith('/api/preview') && previews++ === 0;  // counted as asked, not as answered
+  const res = await real(url, opts);
+  if (!first) return res;
+  const img = document.getElementById('preview-img');
+  while (img.hidden || !img.complete || img.naturalWidth <= 1) {
+    await new Promise((r) => setTimeout(r, 50));
+  }
+  const c = document.createElement('canvas');
+  c.width = c.height = 1;
+  const tiny = await new Promise((r) => c.toBlob(r, 'image/png'));
+  setTimeout(() => { window.firstDelivered = true; }, 500);
+  return new Response(tiny, { status: 200, headers: { 'Content-Type': 'image/png' } });
+};"""
+
+
+def test_a_preview_asked_before_another_does_not_replace_it(browser: Any, live_server: LiveServer) -> None:
+    # A preview renders for seconds; closed and asked again for another frame, the first one's picture came in
+    # after the second's and took its place under the second's title (frame 12 said, frame 2 shown).
+    open_editor(browser, live_server)
+    js_errors(browser)
+    browser.execute_script(HOLD_FIRST_PREVIEW)
+    browser.execute_script("window.mmusvEditor.state.setFrame(2)")
+    browser.find_element(By.ID, "preview").click()
+    browser.find_element(By.ID, "preview-close").click()
+    browser.execute_script("window.mmusvEditor.state.setFrame(12)")
+    browser.find_element(By.ID, "preview").click()
+    _wait(browser, "return window.firstDelivered", "the first preview's reply")
+    shown = browser.execute_script(
+        "const i = document.getElementById('preview-img'); return [i.hidden, i.naturalWidth, "
+        "document.getElementById('preview-wait').hidden]"
+    )
+    assert shown == [False, shown[1], True] and shown[1] > 1, shown  # was: the 1 x 1 picture of the first
+    assert "frame 12" in browser.find_element(By.ID, "preview-title").text
     assert js_errors(browser) == []

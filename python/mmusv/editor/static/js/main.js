@@ -368,7 +368,13 @@ function closePreview() {
   back.focus();
 }
 
+// Each preview asked for takes a number; a reply is shown only while its number is the last one asked (a preview
+// renders for seconds: closed and asked again for another frame, the first reply came in after the second and took
+// its place under the second's title).
+let previewAsked = 0;
+
 async function preview() {
+  const asked = ++previewAsked;
   const usvs = (state.doc?.vessels || []).filter((v) => v.role === "usv").map((v) => v.id);
   const agent = usvs.includes(state.selected) ? state.selected : usvs[0];
   if ($("preview-modal").hidden) previewOpener = document.activeElement;
@@ -380,6 +386,7 @@ async function preview() {
   $("preview-title").textContent = `Preview · ${agent || "no USV"} · frame ${state.frame}`;
   try {
     const blob = await api.preview(state.doc, state.frame, agent || null);
+    if (asked !== previewAsked) return;
     const img = $("preview-img");
     if (img.src) URL.revokeObjectURL(img.src);
     img.src = URL.createObjectURL(blob);
@@ -388,6 +395,7 @@ async function preview() {
       img.hidden = false;
     };
   } catch (err) {
+    if (asked !== previewAsked) return;
     $("preview-wait").textContent = `No preview: ${err.message}`;
   }
 }
