@@ -15,6 +15,17 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 
+TINY = {
+    "name": "tiny", "seed": 1, "acquisition": {"frequency_hz": 5, "frames": 6},
+    "map": {"type": "open_sea", "seed": 0, "params": {"extent_m": 800, "islet_probability": 0.0, "n_buoys": 0}},
+    "rigs": {"r": {"preset": "lidar_only"}},
+    "vessels": [
+        {"id": "usv", "role": "usv", "asset": "usv_wamv", "rig": "r", "speed_mps": 2.0, "route": [[0, 0], [90, 0]]},
+        {"id": "tug", "role": "target", "asset": "tug_32m", "speed_mps": 2.0, "route": [[40, 20], [140, 20]]},
+    ],
+}  # fmt: skip
+"""Six frames of one USV and a tug on open sea: a recording made in a few seconds."""
+
 # a signal sent to the process at the moment the named module starts loading (a Ctrl-C or a kill then)
 _SIGNAL_AT = """\
 import os, signal, sys
@@ -183,19 +194,10 @@ def test_a_stop_a_library_swallows_still_ends_the_run_in_one_line(tmp_path: Path
 
 def test_a_stop_a_library_swallows_still_ends_the_conversion(tmp_path: Path) -> None:
     # As for the recording (above): mmusv convert's frame loop raises a noted stop again.
-    scenario = {
-        "name": "tiny", "seed": 1, "acquisition": {"frequency_hz": 5, "frames": 6},
-        "map": {"type": "open_sea", "seed": 0, "params": {"extent_m": 800, "islet_probability": 0.0, "n_buoys": 0}},
-        "rigs": {"r": {"preset": "lidar_only"}},
-        "vessels": [
-            {"id": "usv", "role": "usv", "asset": "usv_wamv", "rig": "r", "speed_mps": 2.0, "route": [[0, 0], [90, 0]]},
-            {"id": "tug", "role": "target", "asset": "tug_32m", "speed_mps": 2.0, "route": [[40, 20], [140, 20]]},
-        ],
-    }  # fmt: skip
     code = (
         "import os, signal, sys, time\n"
         "from mmusv.acquire import run\n"
-        f"res = run({scenario!r}, out_dir={str(tmp_path / 'rec')!r})\n"
+        f"res = run({TINY!r}, out_dir={str(tmp_path / 'rec')!r})\n"
         f"sys.argv = ['mmusv', 'convert', str(res.recording), '--to', 'kitti', '-o', {str(tmp_path / 'kitti')!r}, "
         "'--no-progress']\n"
         "import mmusv.export.conversion as conversion\n"

@@ -4,7 +4,9 @@ older than the next poll's. Either one, coming after the poll that saw the run e
 with its Stop button, and nothing polled it again: the page showed a stopped run as running for good. CI saw
 ``test_an_interrupted_run_is_told_as_an_error`` wait 60 s for the stop. A run that has ended now stays ended, and
 its progress never goes back. The preview had the same fault: a preview closed and asked again for another frame
-showed the first one's picture if it came in last; a reply is now shown only if it is the last asked for.
+showed the first one's picture if it came in last; and so had opening a file: the Open box's arrow keys open each
+file they pass, and a file read coming in after the next one's showed the file passed. A reply is now shown only if
+it is the last asked for.
 
 Each browser test checks the browser's console for JavaScript errors (failed requests the page explains are not
 errors).
@@ -12,12 +14,16 @@ errors).
 
 from __future__ import annotations
 
+import shutil
+from pathlib import Path
 from typing import Any
 
 import pytest
+from editor_server import serve
+from mmusv.bundled import resolve_scenario
 from selenium.webdriver.common.by import By
 from selenium.webdriver.support.select import Select
-from test_browser import LiveServer, _wait, open_editor, settled
+from test_browser import LiveServer, _wait, open_editor, pick_open, settled
 from test_browser_round import js_errors, type_into
 from test_browser_round2 import save_as
 
@@ -111,3 +117,35 @@ def test_a_preview_asked_before_another_does_not_replace_it(browser: Any, live_s
     assert shown == [False, shown[1], True] and shown[1] > 1, shown  # was: the 1 x 1 picture of the first
     assert "frame 12" in browser.find_element(By.ID, "preview-title").text
     assert js_errors(browser) == []
+
+
+# The reply to the first file read is held until the page shows later.yaml, then given to the page.
+HOLD_FIRST_FILE = """const real = window.fetch;
+window.firstDelivered = false;
+window.fetch = async (url, opts) => {
+  const res = await real(url, opts);
+  if (!String(url).endsWith('/api/files/first.yaml')) return res;
+  while (window.mmusvEditor.state.savedName !== 'later.yaml') await new Promise((r) => setTimeout(r, 50));
+  setTimeout(() => { window.firstDelivered = true; }, 800);
+  return res;
+};"""
+
+
+def test_a_file_opened_before_another_does_not_replace_it(browser: Any, folder: Path) -> None:
+    # The Open box opened first.yaml, then later.yaml before the first had come (arrow keys on the box open each
+    # file they pass): the first's reply coming in last showed first.yaml, the file not picked last.
+    shutil.copy(resolve_scenario("port_entry"), folder / "first.yaml")
+    shutil.copy(resolve_scenario("open_sea_convoy"), folder / "later.yaml")
+    with serve(folder) as server:
+        open_editor(browser, server)
+        js_errors(browser)
+        browser.execute_script(HOLD_FIRST_FILE)
+        pick_open(browser, "file:first.yaml")
+        browser.execute_script("document.activeElement.blur()")
+        pick_open(browser, "file:later.yaml")
+        _wait(browser, "return window.firstDelivered", "the first file's reply")
+        # was: first.yaml (port_entry) shown, named in the address and the status
+        assert browser.execute_script("return window.mmusvEditor.state.savedName") == "later.yaml"
+        assert browser.execute_script("return window.mmusvEditor.state.doc.name") == "open_sea_convoy"
+        assert browser.execute_script("return location.hash") == "#file:later.yaml"
+        assert js_errors(browser) == []

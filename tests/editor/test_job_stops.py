@@ -20,16 +20,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-
-SCENARIO = {
-    "name": "tiny", "seed": 1, "acquisition": {"frequency_hz": 5, "frames": 6},
-    "map": {"type": "open_sea", "seed": 0, "params": {"extent_m": 800, "islet_probability": 0.0, "n_buoys": 0}},
-    "rigs": {"r": {"preset": "lidar_only"}},
-    "vessels": [
-        {"id": "usv", "role": "usv", "asset": "usv_wamv", "rig": "r", "speed_mps": 2.0, "route": [[0, 0], [90, 0]]},
-        {"id": "tug", "role": "target", "asset": "tug_32m", "speed_mps": 2.0, "route": [[40, 20], [140, 20]]},
-    ],
-}  # fmt: skip
+from test_launch import TINY
 
 STOP = "os.kill(os.getpid(), signal.SIGINT)\ntime.sleep(5)\n"
 
@@ -54,7 +45,7 @@ _IN_A_FRAME = {
 
 def _job(tmp_path: Path, patch: str) -> tuple[subprocess.CompletedProcess[str], list[dict[str, Any]]]:
     scenario = tmp_path / "tiny.yaml"
-    scenario.write_text(json.dumps(SCENARIO), encoding="utf-8")
+    scenario.write_text(json.dumps(TINY), encoding="utf-8")
     code = (
         "import json, os, signal, sys, time\n"
         f"{patch}"

@@ -186,15 +186,23 @@ function assetEntries(doc) {
   return { entries, key: JSON.stringify(entries) };
 }
 
+// Each scenario asked to be shown takes a number, and is shown only while its number is the last one asked: the Open
+// box's arrow keys open each file they pass, and a file's reply coming in after a later one's showed that file, not
+// the one picked last.
+let showAsked = 0;
+
 /** Shows the scenario `opened` (state.load's argument) with its own library: the built-in assets and its asset
  * files' (the library loaded once at the start listed the assets the server held then, so a scenario opened later
  * lacked its own and listed another's, refused as "unknown asset" once placed). Both are shown at once, never the
- * new scenario with the library of the one before. Rejects, showing nothing new, when the library cannot be had. */
-async function show(opened) {
+ * new scenario with the library of the one before. Rejects, showing nothing new, when the library cannot be had;
+ * resolves false, showing nothing, where another scenario was asked for since `asked` (`showAsked`). */
+async function show(opened, asked = ++showAsked) {
   const { entries, key } = assetEntries(opened.document);
   const assets = await api.assets(entries);
+  if (asked !== showAsked) return false; // another scenario was asked for meanwhile
   panels.setAssets(assets, key);
   state.load(opened);
+  return true;
 }
 
 // A change of the scenario's `assets:` (none of the page's forms makes one; an undo could): its library again
@@ -216,23 +224,37 @@ async function refreshLibrary() {
   }
 }
 
-/** Loads `value` (`file:NAME` or `bundled:NAME`, as the Open box names them); rejects when it cannot. */
+/** Loads `value` (`file:NAME` or `bundled:NAME`, as the Open box names them); rejects when it cannot. Resolves
+ * false, showing nothing, where another scenario was asked for before it came (`showAsked`). */
 async function load(value) {
+  const asked = ++showAsked;
   const [kind, name] = [value.slice(0, value.indexOf(":")), value.slice(value.indexOf(":") + 1)];
-  const res = kind === "file" ? await api.readFile(name) : await api.bundledOne(name);
-  await show({
-    document: res.document,
-    comment: res.comment,
-    comments: res.comments,
-    name: res.name,
-    savedName: kind === "file" ? res.name : null,
-  });
+  let res;
+  try {
+    res = kind === "file" ? await api.readFile(name) : await api.bundledOne(name);
+  } catch (err) {
+    if (asked !== showAsked) return false; // not the scenario asked for last: nothing to say of it
+    throw err;
+  }
+  if (asked !== showAsked) return false;
+  const shown = await show(
+    {
+      document: res.document,
+      comment: res.comment,
+      comments: res.comments,
+      name: res.name,
+      savedName: kind === "file" ? res.name : null,
+    },
+    asked,
+  );
+  if (!shown) return false;
   savedEtag = kind === "file" ? res.etag : null;
   openedBundled = kind === "bundled" ? name : null;
   bootNote = "";
   newNote = "";
   remember();
   status(`opened ${kind === "file" ? name : `bundled ${name}`}${res.valid ? "" : " (it does not validate: see Checks)"}`);
+  return true;
 }
 
 /** Names the scenario open in the page's address (#file:NAME or #bundled:NAME), so a reload opens it again. */
@@ -254,8 +276,7 @@ async function open(value) {
     return;
   }
   try {
-    await load(value);
-    if (state.savedName && currentRun?.status !== "running") await showLastRun();
+    if ((await load(value)) && state.savedName && currentRun?.status !== "running") await showLastRun();
   } catch (err) {
     status(err.message, true);
   }
