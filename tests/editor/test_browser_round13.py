@@ -4,9 +4,9 @@ older than the next poll's. Either one, coming after the poll that saw the run e
 with its Stop button, and nothing polled it again: the page showed a stopped run as running for good. CI saw
 ``test_an_interrupted_run_is_told_as_an_error`` wait 60 s for the stop. A run that has ended now stays ended, and
 its progress never goes back. The preview had the same fault: a preview closed and asked again for another frame
-showed the first one's picture if it came in last; and so had opening a file: the Open box's arrow keys open each
-file they pass, and a file read coming in after the next one's showed the file passed. A reply is now shown only if
-it is the last asked for.
+showed the first one's picture if it came in last (or as its picture finished loading); and so had opening a file:
+the Open box's arrow keys open each file they pass, and a file read coming in after the next one's showed the file
+passed. A reply is now shown only if it is the last asked for.
 
 Each browser test checks the browser's console for JavaScript errors (failed requests the page explains are not
 errors).
@@ -149,3 +149,38 @@ def test_a_file_opened_before_another_does_not_replace_it(browser: Any, folder: 
         assert browser.execute_script("return window.mmusvEditor.state.doc.name") == "open_sea_convoy"
         assert browser.execute_script("return location.hash") == "#file:later.yaml"
         assert js_errors(browser) == []
+
+
+HOLD_PREVIEWS = """const real = window.fetch;
+window.releasePreviews = false;
+window.fetch = async (url, opts) => {
+  const res = await real(url, opts);
+  if (String(url).endsWith('/api/preview')) {
+    while (!window.releasePreviews) await new Promise((r) => setTimeout(r, 50));
+  }
+  return res;
+};"""
+SHOWN = "const d = (id) => document.getElementById(id); return [d('preview-img').hidden, d('preview-wait').hidden]"
+
+
+def test_a_picture_loaded_after_another_preview_was_asked_for_does_not_show(
+    browser: Any, live_server: LiveServer
+) -> None:
+    # The picture of a preview whose load ends once another preview was asked for (its image's onload, still the
+    # first one's until the second's reply comes) showed it, and hid the wait, under the second's title.
+    open_editor(browser, live_server)
+    js_errors(browser)
+    browser.execute_script("window.mmusvEditor.state.setFrame(2)")
+    browser.find_element(By.ID, "preview").click()
+    _wait(browser, "const i = document.getElementById('preview-img'); return !i.hidden && i.naturalWidth > 1", "it")
+    browser.find_element(By.ID, "preview-close").click()
+    browser.execute_script(HOLD_PREVIEWS)
+    browser.execute_script("window.mmusvEditor.state.setFrame(12)")
+    browser.find_element(By.ID, "preview").click()
+    assert browser.execute_script(SHOWN) == [True, False]
+    browser.execute_script("document.getElementById('preview-img').onload()")  # the first picture's load ends
+    assert browser.execute_script(SHOWN) == [True, False]  # was: [False, True], frame 2's picture shown
+    browser.execute_script("window.releasePreviews = true")
+    _wait(browser, f"return JSON.stringify((() => {{ {SHOWN} }})()) === '[false,true]'", "the second preview")
+    assert "frame 12" in browser.find_element(By.ID, "preview-title").text
+    assert js_errors(browser) == []

@@ -412,6 +412,7 @@ async function preview() {
     if (img.src) URL.revokeObjectURL(img.src);
     img.src = URL.createObjectURL(blob);
     img.onload = () => {
+      if (asked !== previewAsked) return; // loaded as another preview was asked for: that one's wait stays
       $("preview-wait").hidden = true;
       img.hidden = false;
     };
