@@ -27,7 +27,7 @@ from mmusv.generate.hulls import capsule
 from mmusv.generate.mapctx import MapContext
 from mmusv.generate.sampler import CandidateMeta
 from mmusv.generate.spec_models import GenerationSpec
-from mmusv.motion import build_fleet
+from mmusv.motion import build_fleet, fleet_poses
 from mmusv.world.vessels import get_asset
 
 __all__ = [
@@ -207,7 +207,7 @@ def take_samples(scenario: Scenario, meta: CandidateMeta, ctx: MapContext, spec:
         raise ConfigError(f"{problem}: {FEWER_TIMES}, shorten the routes or lower the speeds")
     times = np.linspace(0.0, t_last, n_t)
     frame_times = np.arange(acq.frames, dtype=np.float64) / acq.frequency_hz
-    poses = np.asarray(fleet.poses_at_times(np.concatenate([times, frame_times])))
+    poses = fleet_poses(fleet, np.concatenate([times, frame_times]), vessels=len(vessels))  # Ctrl-C between batches
     motion, frames = poses[:n_t, :, :2], poses[n_t:, :, :2]
     geo_fleet = core.Fleet(
         routes=[np.ascontiguousarray(v.route, dtype=np.float64) for v in vessels],
@@ -222,7 +222,7 @@ def take_samples(scenario: Scenario, meta: CandidateMeta, ctx: MapContext, spec:
         seed=0,
         wave="W0",
     )
-    geo_poses = np.asarray(geo_fleet.poses_at_times(np.linspace(0.0, 1.0, n_g)))
+    geo_poses = fleet_poses(geo_fleet, np.linspace(0.0, 1.0, n_g), vessels=len(vessels))
     assets = [get_asset(v.asset) for v in vessels]
     caps = np.array([capsule(v.asset) for v in vessels])
     half = caps[:, 0]
