@@ -66,26 +66,21 @@ def main(argv: list[str] | None = None) -> int:
     from mmusv.held_signals import HeldSignals, StopSignals, forget_handled_interrupt
 
     # A stop while the run's modules load is held to the end of the load, not raised inside it: a library's
-    # ``except`` around an optional import swallowed it, and the run went on to its last frame.
+    # ``except`` around an optional import swallowed it, and the run went on to its last frame (as mmusv._launch).
     held = HeldSignals().hold()
     try:
         from mmusv.acquire import run
         from mmusv.errors import MmusvError
-    except KeyboardInterrupt:  # before the hold (Python's own start) or a handler outside Python
-        noted: int | None = signal.SIGINT
-    else:
-        noted = None
     finally:
-        noted_while_held = held.release(hand_on=False)
-    noted = noted or noted_while_held
+        noted = held.release(hand_on=False)
     if noted is not None:
         _say({"status": "interrupted", "error": "stopped before the first frame"})
-        forget_handled_interrupt()
         return 128 + noted
     # The stop is noted as ``mmusv run`` notes it (held_signals): raised again at the next frame where a library
     # swallowed its KeyboardInterrupt (the run went on to its last frame and said "complete"), and an error a library
     # made of it is the stop (a traceback, no status line: "the run process ended with status 1").
     with StopSignals() as stops:
+        res = None
         try:
             res = run(
                 args.scenario,
@@ -103,11 +98,13 @@ def main(argv: list[str] | None = None) -> int:
         except Exception:
             if stops.received is None:
                 raise
-        else:
-            # The run is over: a stop from here on (the editor's button pressed as it ended, or one a library
-            # swallowed in the last frame) is too late to change it. It ended the process with a traceback before
-            # the status line, and the editor then said "stopped before the first frame" of a complete run.
-            signal.signal(signal.SIGINT, signal.SIG_IGN)
+        # From here a stop changes nothing: a second one would cut the status line, and one after a complete run
+        # (the editor's button pressed as it ended, or one a library swallowed in the last frame) is too late. It
+        # ended the process with a traceback before the status line, and the editor then said "stopped before the
+        # first frame" of a complete run.
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        forget_handled_interrupt()
+        if res is not None:
             _say(
                 {
                     "status": res.status,
@@ -116,9 +113,7 @@ def main(argv: list[str] | None = None) -> int:
                     "seconds": round(res.seconds, 3),
                 }
             )
-            forget_handled_interrupt()
             return 0
-        signal.signal(signal.SIGINT, signal.SIG_IGN)  # a second stop would cut the status line
         kept = _kept(args)
         if kept.get("status") == "complete":  # every frame was written before the stop came
             _say({**kept, "seconds": None})
@@ -127,7 +122,6 @@ def main(argv: list[str] | None = None) -> int:
         # A newline first ends any line the stop cut short (the editor passes an empty line over).
         sys.stdout.write("\n")
         _say({"status": "interrupted", "error": "stopped; the recording holds every completed frame", **kept})
-        forget_handled_interrupt()
         return 128 + (stops.received or signal.SIGINT)
 
 
