@@ -20,26 +20,13 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from test_launch import TINY
+from test_launch import _SWALLOWS, TINY
 
-STOP = "os.kill(os.getpid(), signal.SIGINT)\ntime.sleep(5)\n"
-
-
-def _at(depth: int, code: str) -> str:
-    """``code`` indented ``depth`` levels (4 spaces each)."""
-    return "".join(" " * 4 * depth + line + "\n" for line in code.splitlines())
-
-
+# the swallowed stops of ``mmusv run``'s own test (``except``, ``finalizer``), and a library's error made of it
 _IN_A_FRAME = {
-    # a library's ``except`` around the code the stop landed in
-    "swallowed": _at(2, "try:") + _at(3, STOP) + _at(2, "except KeyboardInterrupt:\n    pass"),
-    # a finalizer (importlib's module-lock callback): Python reports it as "Exception ignored in" and goes on
-    "finalizer": _at(2, "class Lock:\n    def __del__(self):") + _at(4, STOP) + _at(2, "Lock()"),
-    # a library's error of its own made of the stop
-    "wrapped": _at(2, "try:")
-    + _at(3, STOP)
-    + _at(2, "except KeyboardInterrupt as exc:")
-    + _at(3, "raise RuntimeError('Error building a validator: KeyboardInterrupt') from exc"),
+    **_SWALLOWS,
+    "wrapped": "        try:\n            stop()\n        except KeyboardInterrupt as exc:\n"
+    "            raise RuntimeError('Error building a validator: KeyboardInterrupt') from exc\n",
 }
 
 
@@ -48,6 +35,7 @@ def _job(tmp_path: Path, patch: str) -> tuple[subprocess.CompletedProcess[str], 
     scenario.write_text(json.dumps(TINY), encoding="utf-8")
     code = (
         "import json, os, signal, sys, time\n"
+        "def stop():\n    os.kill(os.getpid(), signal.SIGINT)\n    time.sleep(5)\n"
         f"{patch}"
         "from mmusv.editor.job import main\n"
         f"code = main([{str(scenario)!r}, {str(tmp_path / 'out')!r}])\n"
@@ -78,7 +66,7 @@ def test_a_stop_a_library_meets_in_a_frame_ends_the_run_as_a_stop(tmp_path: Path
     )
     out, lines = _job(tmp_path, patch)
     status = [m for m in lines if "status" in m]
-    # was: {"status": "complete", "frames": 6, ...} (swallowed, finalizer); no line and status 1 (wrapped)
+    # was: {"status": "complete", "frames": 6, ...} (except, finalizer); no line and status 1 (wrapped)
     assert [m["status"] for m in status] == ["interrupted"], (out.stdout, out.stderr)
     assert [m["captured"] for m in lines if "captured" in m] == [0, 1]  # no frame captured after the stop
     frames = 1 if how == "wrapped" else 2  # the wrapped stop ends frame 1 itself; a swallowed one lets it finish
@@ -94,10 +82,11 @@ def test_a_stop_a_library_swallows_while_the_run_loads_ends_it_before_the_first_
         "def loading(name, *args, **kwargs):\n"
         "    if name == 'mmusv.acquire' and not seen:\n"
         "        seen.append(name)\n"
-        + _at(2, "try:  # a library's optional import")
-        + _at(3, STOP)
-        + _at(2, "except KeyboardInterrupt:\n    pass")
-        + "    return real_import(name, *args, **kwargs)\n"
+        "        try:  # a library's optional import\n"
+        "            stop()\n"
+        "        except KeyboardInterrupt:\n"
+        "            pass\n"
+        "    return real_import(name, *args, **kwargs)\n"
         "builtins.__import__ = loading\n"
     )
     out, lines = _job(tmp_path, patch)
