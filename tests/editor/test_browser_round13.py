@@ -29,23 +29,33 @@ from test_browser_round2 import save_as
 
 ENDED = "return document.getElementById('run-status').dataset.status === 'interrupted'"
 
-# The reply to the first request that `late` picks is held until the page shows the run ended, then given to the
-# page; `window.lateDelivered` says when the page has it.
-HOLD_ONE_REPLY = """const real = window.fetch, late = arguments[0];
-let held = false;
-window.lateDelivered = false;
+HOLD = """const [method, pattern, until, every, tiny, settleMs] = arguments;
+const real = window.fetch, re = new RegExp(pattern), ready = new Function(`return (${until});`);
+let asked = 0;
+window.heldDelivered = false;
 window.fetch = async (url, opts) => {
+  const held = ((opts && opts.method) || 'GET') === method && re.test(String(url)) && (every || asked++ === 0);
   const res = await real(url, opts);
-  const method = (opts && opts.method) || 'GET';
-  if (!held && method === late && /\\/api\\/runs\\/\\d+$/.test(String(url))) {
-    held = true;
-    while (document.getElementById('run-status').dataset.status !== 'interrupted') {
-      await new Promise((r) => setTimeout(r, 50));
-    }
-    setTimeout(() => { window.lateDelivered = true; }, 300);
-  }
-  return res;
+  if (!held) return res;
+  while (!ready()) await new Promise((r) => setTimeout(r, 50));
+  setTimeout(() => { window.heldDelivered = true; }, settleMs);
+  if (!tiny) return res;
+  const c = document.createElement('canvas');
+  c.width = c.height = 1;
+  const png = await new Promise((r) => c.toBlob(r, 'image/png'));
+  return new Response(png, { status: 200, headers: { 'Content-Type': 'image/png' } });
 };"""
+
+
+def hold_replies(
+    driver: Any, method: str, pattern: str, until: str, *, every: bool = False, tiny: bool = False, settle_ms: int = 300
+) -> None:
+    """Holds the reply to the page's first request of ``method`` whose address matches the regular expression
+    ``pattern`` (``every``: each such request's) until the JavaScript expression ``until`` is true, then hands it to
+    the page; ``window.heldDelivered`` turns true ``settle_ms`` later (the page has handled it). A request is counted
+    as it is asked, not as it is answered (the server may answer a later one first). ``tiny``: the held reply is
+    replaced by a 1 x 1 PNG, so that the page's picture tells whose reply it shows."""
+    driver.execute_script(HOLD, method, pattern, until, every, tiny, settle_ms)
 
 
 @pytest.mark.parametrize("late", ["DELETE", "GET"], ids=["the stop's reply", "a poll's reply"])
@@ -60,7 +70,8 @@ def test_a_reply_older_than_the_run_s_end_does_not_start_it_again(
     settled(browser)
     save_as(browser, f"late_{late.lower()}.yaml")  # a file of its own: the folder is the module's
     type_into(browser, browser.find_element(By.ID, "run-frames"), "")
-    browser.execute_script(HOLD_ONE_REPLY, late)
+    # the stop's reply, or the first poll's, held until the page shows the run ended
+    hold_replies(browser, late, r"/api/runs/\d+$", ENDED.removeprefix("return "))
     browser.find_element(By.ID, "run").click()
     _wait(browser, "return document.getElementById('run-status').dataset.status === 'running'", "the run")
     if late == "GET":  # the first poll's reply is the one held: it must be asked for before the stop
@@ -68,7 +79,7 @@ def test_a_reply_older_than_the_run_s_end_does_not_start_it_again(
         browser.execute_script("return new Promise((r) => setTimeout(r, 500))")
     browser.find_element(By.ID, "run-stop").click()
     _wait(browser, ENDED, "the stop")
-    _wait(browser, "return window.lateDelivered", "the late reply")
+    _wait(browser, "return window.heldDelivered", "the late reply")
     # was: "running · frame 0", the Stop button shown, and no poll left to correct it
     assert browser.execute_script(ENDED)
     assert browser.find_element(By.ID, "run-text").text.startswith("interrupted: ")
@@ -76,40 +87,21 @@ def test_a_reply_older_than_the_run_s_end_does_not_start_it_again(
     assert js_errors(browser) == []
 
 
-# The reply to the first preview asked for is held until a picture is shown (the second's: the first's is held), and
-# then given to the page as a 1 x 1 picture (so that the page's picture tells whose reply it shows). The server may
-# answer the second first.
-HOLD_FIRST_PREVIEW = """const real = window.fetch;
-let previews = 0;
-window.firstDelivered = false;
-window.fetch = async (url, opts) => {
-  const first = String(url).endsWith('/api/preview') && previews++ === 0;  // counted as asked, not as answered
-  const res = await real(url, opts);
-  if (!first) return res;
-  const img = document.getElementById('preview-img');
-  while (img.hidden || !img.complete || img.naturalWidth <= 1) {
-    await new Promise((r) => setTimeout(r, 50));
-  }
-  const c = document.createElement('canvas');
-  c.width = c.height = 1;
-  const tiny = await new Promise((r) => c.toBlob(r, 'image/png'));
-  setTimeout(() => { window.firstDelivered = true; }, 500);
-  return new Response(tiny, { status: 200, headers: { 'Content-Type': 'image/png' } });
-};"""
-
-
 def test_a_preview_asked_before_another_does_not_replace_it(browser: Any, live_server: LiveServer) -> None:
     # A preview renders for seconds; closed and asked again for another frame, the first one's picture came in
     # after the second's and took its place under the second's title (frame 12 said, frame 2 shown).
     open_editor(browser, live_server)
     js_errors(browser)
-    browser.execute_script(HOLD_FIRST_PREVIEW)
+    # the first preview's reply held until a picture is shown (the second's), then handed on as a 1 x 1 picture
+    img = "document.getElementById('preview-img')"
+    picture = f"!{img}.hidden && {img}.complete && {img}.naturalWidth > 1"
+    hold_replies(browser, "POST", "/api/preview$", picture, tiny=True, settle_ms=500)
     browser.execute_script("window.mmusvEditor.state.setFrame(2)")
     browser.find_element(By.ID, "preview").click()
     browser.find_element(By.ID, "preview-close").click()
     browser.execute_script("window.mmusvEditor.state.setFrame(12)")
     browser.find_element(By.ID, "preview").click()
-    _wait(browser, "return window.firstDelivered", "the first preview's reply")
+    _wait(browser, "return window.heldDelivered", "the first preview's reply")
     shown = browser.execute_script(
         "const i = document.getElementById('preview-img'); return [i.hidden, i.naturalWidth, "
         "document.getElementById('preview-wait').hidden]"
@@ -117,18 +109,6 @@ def test_a_preview_asked_before_another_does_not_replace_it(browser: Any, live_s
     assert shown == [False, shown[1], True] and shown[1] > 1, shown  # was: the 1 x 1 picture of the first
     assert "frame 12" in browser.find_element(By.ID, "preview-title").text
     assert js_errors(browser) == []
-
-
-# The reply to the first file read is held until the page shows later.yaml, then given to the page.
-HOLD_FIRST_FILE = """const real = window.fetch;
-window.firstDelivered = false;
-window.fetch = async (url, opts) => {
-  const res = await real(url, opts);
-  if (!String(url).endsWith('/api/files/first.yaml')) return res;
-  while (window.mmusvEditor.state.savedName !== 'later.yaml') await new Promise((r) => setTimeout(r, 50));
-  setTimeout(() => { window.firstDelivered = true; }, 800);
-  return res;
-};"""
 
 
 def test_a_file_opened_before_another_does_not_replace_it(browser: Any, folder: Path) -> None:
@@ -139,11 +119,13 @@ def test_a_file_opened_before_another_does_not_replace_it(browser: Any, folder: 
     with serve(folder) as server:
         open_editor(browser, server)
         js_errors(browser)
-        browser.execute_script(HOLD_FIRST_FILE)
+        # the first file's read held until later.yaml is shown
+        later = "window.mmusvEditor.state.savedName === 'later.yaml'"
+        hold_replies(browser, "GET", r"/api/files/first\.yaml$", later, settle_ms=800)
         pick_open(browser, "file:first.yaml")
         browser.execute_script("document.activeElement.blur()")
         pick_open(browser, "file:later.yaml")
-        _wait(browser, "return window.firstDelivered", "the first file's reply")
+        _wait(browser, "return window.heldDelivered", "the first file's reply")
         # was: first.yaml (port_entry) shown, named in the address and the status
         assert browser.execute_script("return window.mmusvEditor.state.savedName") == "later.yaml"
         assert browser.execute_script("return window.mmusvEditor.state.doc.name") == "open_sea_convoy"
@@ -151,15 +133,6 @@ def test_a_file_opened_before_another_does_not_replace_it(browser: Any, folder: 
         assert js_errors(browser) == []
 
 
-HOLD_PREVIEWS = """const real = window.fetch;
-window.releasePreviews = false;
-window.fetch = async (url, opts) => {
-  const res = await real(url, opts);
-  if (String(url).endsWith('/api/preview')) {
-    while (!window.releasePreviews) await new Promise((r) => setTimeout(r, 50));
-  }
-  return res;
-};"""
 SHOWN = "const d = (id) => document.getElementById(id); return [d('preview-img').hidden, d('preview-wait').hidden]"
 
 
@@ -174,7 +147,7 @@ def test_a_picture_loaded_after_another_preview_was_asked_for_does_not_show(
     browser.find_element(By.ID, "preview").click()
     _wait(browser, "const i = document.getElementById('preview-img'); return !i.hidden && i.naturalWidth > 1", "it")
     browser.find_element(By.ID, "preview-close").click()
-    browser.execute_script(HOLD_PREVIEWS)
+    hold_replies(browser, "POST", "/api/preview$", "window.releasePreviews", every=True)  # each, until released
     browser.execute_script("window.mmusvEditor.state.setFrame(12)")
     browser.find_element(By.ID, "preview").click()
     assert browser.execute_script(SHOWN) == [True, False]
