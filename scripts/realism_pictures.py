@@ -21,6 +21,8 @@ with the new one, draws the same frames from the same poses. Each view is writte
 * ``exposure_settings``: that view at 21:15 through four cameras differing only in their ``exposure`` (the
   default, −1 EV, +1 EV, ISO 25 600; *after* only);
 * ``whitecaps_w3``: open water at wave level W3, from 8 m above the sea;
+* ``rain``: a 32 m tug 60 m off in rain of 25 mm/h at 12:00, 20:00 and 23:00 (480 × 270 each, side by side): the
+  drops near the lens;
 * ``wake_chase``: a 35 m patrol boat at 14 m/s, seen from 20 m above a vessel following 100 m behind;
 * ``wake_top``: the same boat in its own top view (orthographic, heading up, 0.6 m per pixel);
 * ``wake_kelvin``: a 20 m motor yacht at 7 m/s on calm water (W0), from 25 m up, 130 m off its wake;
@@ -280,6 +282,25 @@ def whitecaps_w3(path: Path) -> None:
     _save_rgb(_scenario("whitecaps_w3", rig=rig, vessels=[buoy], environment=env), path)
 
 
+def rain(path: Path) -> None:
+    """A tug under way (2 m/s), 60 m off, in heavy rain (25 mm/h, the visibility the drops leave) at 12:00, 20:00
+    and 23:00 on 21 June at 45° N, from 3 m above the sea: 480 × 270 each, side by side."""
+    from PIL import Image
+
+    bearing = 100.0
+    tug = {"id": "tug", "asset": "tug_32m", "speed_mps": 2.0, "route": _route(*_at(bearing, 60.0), 180.0)}
+    rig = _camera_rig(resolution=(480, 270), hfov_deg=70.0, xyz=(0.0, 0.0, 3.0), yaw_deg=bearing, pitch_deg=-4.0)
+    sheet = Image.new("RGB", (3 * 480, 270))
+    with tempfile.TemporaryDirectory(prefix="realism_") as tmp:
+        for i, t in enumerate(["12:00", "20:00", "23:00"]):
+            env = {"time_of_day": t, "weather": "rain", "rain_mm_per_h": 25.0, "wave": "W1"}
+            one = Path(tmp) / f"{i}.png"
+            _save_rgb(_scenario("rain", rig=rig, vessels=[tug], environment=env), one)
+            with Image.open(one) as im:
+                sheet.paste(im, (i * 480, 0))
+    sheet.save(path)
+
+
 _FAST = {"id": "fast", "asset": "patrol_boat_35m", "speed_mps": 14.0, "route": _route(0.0, 0.0, 90.0, 4000.0)}
 
 
@@ -444,6 +465,7 @@ VIEWS: dict[str, Callable[[Path], None]] = {
     "night_fog": night_fog,
     "exposure_settings": exposure_settings,
     "whitecaps_w3": whitecaps_w3,
+    "rain": rain,
     "wake_chase": wake_chase,
     "wake_top": wake_top,
     "wake_kelvin": wake_kelvin,

@@ -23,6 +23,7 @@
 //! labelled sky: with `range_m: 150`, the band of sea from 150 m out to the horizon.
 
 use super::rays;
+use super::shade::rain::{self, RainView};
 use super::shade::tonemap::{self, SensorNoise};
 use super::shade::wake::Wake;
 use super::shade::{ShadeEnv, Shader};
@@ -382,8 +383,8 @@ impl Camera {
     /// Depth, semantic class and instance come from each pixel's centre ray. The RGB image (and the linear
     /// radiance, when asked) is shaded by [`radiance::radiance`]: shadow rays towards the sun, traced water
     /// reflections above `draft` quality, and, on pixels at an edge (a change of instance, class or material, or
-    /// of depth by more than 5 %), the mean of [`Quality::edge_samples`] stratified sub-pixel rays. Then rain,
-    /// sensor noise, exposure and the tone curve.
+    /// of depth by more than 5 %), the mean of [`Quality::edge_samples`] stratified sub-pixel rays. Then rain (the
+    /// drops near the lens, `shade/rain.rs`), sensor noise, exposure and the tone curve.
     pub fn render_with(
         &self,
         scene: &Scene,
@@ -491,9 +492,19 @@ impl Camera {
             // Lamps smaller than a pixel, from the lamps themselves (`camera/lamp_points.rs`).
             self.add_lamp_points(scene, pose, &shader, (&frame, &mut linear))?;
         }
-        if self.cfg.image.noise.is_some() || env.rain_mm_per_h > 0.0 {
-            linear.par_iter_mut().enumerate().for_each(|(i, c)| {
-                *c = shader.rain(*c, (i % w) as u32, (i / w) as u32, options.seed);
+        if let (Projection::Pinhole { hfov }, true) = (self.cfg.projection, env.rain_mm_per_h > 0.0) {
+            // The drops near the lens (`shade/rain.rs`), in the exposure the camera metered.
+            let view = RainView {
+                size: (self.cfg.width, self.cfg.height),
+                f: (f64::from(self.cfg.width) / (2.0 * (0.5 * hfov).tan())) as f32,
+                rotation: pose.rotation,
+                exposure_s: rain::exposure_time_s(k),
+                rain_mm_per_h: env.rain_mm_per_h,
+            };
+            let drops = view.drops(options.seed);
+            let (cover, light) = rain::coverage(view.size, &drops, &frame.depth, |d| shader.drop_radiance(d.dir));
+            linear.par_iter_mut().zip(cover.par_iter().zip(light.par_iter())).for_each(|(c, (&a, &l))| {
+                *c = rain::apply(*c, a, l);
             });
         }
         if options.radiance {

@@ -15,7 +15,9 @@
 //!   restored over that lobe (Turquin's energy compensation);
 //! * [`swell`]: the fixed four-component swell of linear waves, the water's normals where the scene has no
 //!   displaced wave surface;
-//! * [`tonemap`]: physical exposure from the scene's illuminance and the ACES filmic curve.
+//! * [`tonemap`]: physical exposure from the scene's illuminance and the ACES filmic curve;
+//! * [`rain`]: the drops near the lens as motion-blurred streaks (Garg & Nayar's photometric model), each as
+//!   bright as the light it refracts ([`Shader::drop_radiance`]).
 //!
 //! [`ShadeEnv`] and [`SurfaceHit`] (what shading reads) live in `env.rs`, the water's shading from its models in
 //! `water_shading.rs`, [`Lobes`] (a material's lobes for direct light) in [`brdf`].
@@ -38,7 +40,6 @@
 //! `L·T + L_air (1 − T)`, `T = e^{−σ t}` (Koschmieder), `L_air` the horizon sky's radiance along the view's azimuth
 //! (in twilight, the haze in the Earth's shadow, `twilight::shadowed_haze`).
 
-use super::noise::{self, stream};
 use crate::material::Material;
 use crate::scene::Scene;
 use crate::sea::WaveSurface;
@@ -56,6 +57,7 @@ pub mod kelvin;
 pub mod lamp_glitter;
 pub mod lamp_halo;
 pub mod lamp_light;
+pub mod rain;
 pub mod rough_water;
 pub mod sea_ms;
 mod sea_ms_table;
@@ -398,24 +400,12 @@ impl Shader {
         }
     }
 
-    /// Rain on a radiance at pixel `(u, v)`: darkening, and thin bright streaks (positions drawn from `seed`).
-    #[inline]
-    pub fn rain(&self, c: Vec3, u: u32, v: u32, seed: u64) -> Vec3 {
-        let env = &self.env;
-        if env.rain_mm_per_h <= 0.0 {
-            return c;
-        }
-        let strength = (env.rain_mm_per_h / 16.0).min(1.0);
-        let mut out = c * (1.0 - 0.3 * strength);
-        let len = 12u32;
-        let offset = (noise::hash3(seed, stream::RAIN, u as u64) % len as u64) as u32;
-        let segment = (v + offset) / len;
-        let key = ((u as u64) << 32) | segment as u64;
-        if noise::uniform(seed, stream::RAIN, key) < 0.03 * strength as f64 {
-            // A streak adds 12 % of full scale.
-            out += Vec3::splat(0.12 / self.exposure());
-        }
-        out
+    /// The radiance of a rain drop seen along unit `d` ([`rain`]): the cosine-weighted mean of the environment's
+    /// radiance (and the sun's, where it lies ahead) over the half of the sphere the drop looks into, through two
+    /// water surfaces, `T_w (E_env(d) + E_sun max(0, d·s)) / π` (cd/m², linear RGB).
+    pub fn drop_radiance(&self, d: Vec3) -> Vec3 {
+        let sun = if self.sun.z > 0.0 { self.sun_e * self.sun.dot(d).max(0.0) } else { Vec3::ZERO };
+        (self.light.irradiance(d) + sun) * (rain::DROP_TRANSMITTANCE / std::f32::consts::PI)
     }
 }
 
