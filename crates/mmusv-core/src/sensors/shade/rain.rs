@@ -34,6 +34,17 @@
 //!   ([`exposure_time_s`]). By day the shutter is a fraction of a millisecond and the drops are frozen dots; at dusk
 //!   the streaks grow long and faint: the dependence on exposure time Garg & Nayar measured (2007, section 5).
 //!
+//! * **Defocus.** The lens is focused at infinity, so a drop at depth `x` is blurred over a disc of `A f / x`
+//!   pixels, `A = f p / N` the aperture's diameter for a pixel pitch `p` ([`PIXEL_PITCH_M`]): its coverage is
+//!   spread over that disc where it is wider than the drop's image. A wide-angle camera's drops stay sharp (a 2 mm
+//!   drop 0.5 m in front of a 90° 640-pixel camera is 1.3 px across, blurred over 0.5 px); a long lens's are blurred
+//!   several times their size and fade into the haze, as Garg & Nayar found a shallow depth of field to hide rain
+//!   (2007, section 5).
+//! * **What is drawn.** A drop whose most-covered pixel it would change by less than [`MIN_COVERAGE`] of the
+//!   difference between the drop and the background (under one 8-bit level at full contrast) is left out, as are
+//!   drops whose image is under [`MIN_IMAGE_PX`]: what a long exposure smears or a long lens blurs below that is the
+//!   rain's haze, which the visibility holds.
+//!
 //! The drops are a Poisson process, uniform in the image at each depth, so their mid-exposure points are drawn in
 //! the image and a streak that leaves it re-enters at the opposite border (a toroidal wrap): every pixel then gets
 //! exactly the expected coverage, the border's included, as if the drops of the whole frustum had been drawn. A
@@ -43,8 +54,8 @@
 //! frustum slab's geometric optical depth `(π/4) ∫ D² N(D) dD · (x₁ − x₀)`; a drop's coverage sums to its image's
 //! area and runs along the fall's image; `T_w` is the Fresnel integral; the velocity fit is within 3 % of Gunn &
 //! Kinzer's measured table. Not modelled: the drops' oscillations and the speckle and highlights within a streak
-//! (Garg & Nayar, "Photorealistic Rendering of Rain Streaks", ACM TOG 25(3), 2006), drops out of focus (the
-//! lens's depth of field), wind and the camera's own motion (the streaks fall straight down the world's
+//! (Garg & Nayar, "Photorealistic Rendering of Rain Streaks", ACM TOG 25(3), 2006), a lens focused nearer
+//! than infinity, the blur's shape (a square of its width here, not a disc), wind and the camera's own motion (the streaks fall straight down the world's
 //! vertical), drops on the lens, the lamps' light in the drops, splashes, and an orthographic top view (its
 //! pixels are metres across: a drop covers nothing).
 
@@ -72,7 +83,13 @@ pub const MAX_EXPOSURE_S: f32 = 1.0 / 30.0;
 /// through one surface each (the test below integrates it).
 pub const DROP_TRANSMITTANCE: f32 = 0.8717;
 /// Drops whose image is narrower than this (pixels) are left out: they cover under 0.8 % of a pixel.
-const MIN_IMAGE_PX: f32 = 0.1;
+pub const MIN_IMAGE_PX: f32 = 0.1;
+/// Drops that would cover no pixel more than this share of the exposure are left out (1/255: one 8-bit level at
+/// the full contrast between drop and background).
+pub const MIN_COVERAGE: f32 = 1.0 / 255.0;
+/// The sensor's pixel pitch, metres (3.45 µm, a common machine-vision sensor's: Sony IMX250, IMX264): with the
+/// focal length in pixels and the f-number it sets the aperture, and so the drops' defocus.
+pub const PIXEL_PITCH_M: f32 = 3.45e-6;
 /// Most steps along one streak (its coverage is spread over them).
 const MAX_STEPS: usize = 4096;
 
@@ -138,10 +155,28 @@ pub struct Drop {
     pub streak: [f32; 2],
     /// The image's diameter, pixels.
     pub width_px: f32,
+    /// The diameter of its defocus blur, pixels (the lens focused at infinity).
+    pub blur_px: f32,
     /// Depth along the optical axis, metres.
     pub depth_m: f32,
     /// Unit direction from the camera to the drop, world frame.
     pub dir: Vec3,
+}
+
+impl Drop {
+    /// The diameter (pixels) its coverage is spread over across its path: its image's or its blur's, the wider.
+    pub fn spread_px(&self) -> f32 {
+        self.width_px.max(self.blur_px)
+    }
+
+    /// The largest share of one pixel's exposure it covers (about: its image's area over the footprint it sweeps
+    /// across the pixel, the spread at least a pixel wide, for the share of the exposure it stays there).
+    pub fn peak_coverage(&self) -> f32 {
+        let spread = self.spread_px().max(1.0);
+        let len = self.streak[0].hypot(self.streak[1]);
+        let area = std::f32::consts::FRAC_PI_4 * self.width_px * self.width_px;
+        area / (spread * spread) * (spread / len.max(spread)).min(1.0)
+    }
 }
 
 impl RainView {
@@ -174,6 +209,7 @@ impl RainView {
         let (w, h) = (self.size.0 as f32, self.size.1 as f32);
         let (cx, cy) = (0.5 * w, 0.5 * h);
         let down = self.rotation.transpose() * Vec3::NEG_Z;
+        let aperture = self.f * PIXEL_PITCH_M / F_NUMBER;
         let mut out = Vec::with_capacity(count as usize);
         for j in 0..count {
             let u = |k: u64| noise::uniform(seed, stream::RAIN, 1 + 4 * j + k);
@@ -184,19 +220,24 @@ impl RainView {
             if width_px < MIN_IMAGE_PX {
                 continue;
             }
+            let blur_px = aperture * self.f / x;
             let (pu, pv) = (u(2) as f32 * w, u(3) as f32 * h);
             // The drop in the body frame, and its image's velocity (the pinhole u = cx − f y / x, v = cy − f z / x).
             let p = Vec3::new(x, -(pu - cx) * x / self.f, -(pv - cy) * x / self.f);
             let vel = down * terminal_velocity_m_s(d_mm) as f32;
             let du = -self.f * (vel.y * p.x - p.y * vel.x) / (p.x * p.x);
             let dv = -self.f * (vel.z * p.x - p.z * vel.x) / (p.x * p.x);
-            out.push(Drop {
+            let drop = Drop {
                 at: [pu, pv],
                 streak: [du * self.exposure_s, dv * self.exposure_s],
                 width_px,
+                blur_px,
                 depth_m: x,
                 dir: (self.rotation * p).normalize(),
-            });
+            };
+            if drop.peak_coverage() >= MIN_COVERAGE {
+                out.push(drop);
+            }
         }
         out
     }
@@ -224,13 +265,14 @@ pub fn coverage(
         // Steps of at most a pixel along the streak (each splat bilinear), sub-steps of about a pixel across a wide
         // image.
         let steps = ((len.ceil() as usize) + 1).clamp(1, MAX_STEPS);
-        let side = (drop.width_px.ceil() as usize).clamp(1, 16);
+        let spread = drop.spread_px();
+        let side = (spread.ceil() as usize).clamp(1, 16);
         let share = area / (steps * side * side) as f32;
         for s in 0..steps {
             let t = if steps == 1 { 0.0 } else { s as f32 / (steps - 1) as f32 - 0.5 };
             for a in 0..side {
                 for b in 0..side {
-                    let off = |k: usize| ((k as f32 + 0.5) / side as f32 - 0.5) * drop.width_px;
+                    let off = |k: usize| ((k as f32 + 0.5) / side as f32 - 0.5) * spread;
                     let pu = drop.at[0] + t * drop.streak[0] + if side > 1 { off(a) } else { 0.0 };
                     let pv = drop.at[1] + t * drop.streak[1] + if side > 1 { off(b) } else { 0.0 };
                     splat(&mut cover, &mut light, (w, h), (pu, pv), share, l_d, drop.depth_m, depth);
@@ -353,8 +395,10 @@ mod tests {
     fn the_coverage_is_the_slab_s_geometric_optical_depth() {
         // Over many images the mean coverage of a pixel (no surface in front) is the share of its solid angle the
         // drawn drops' images fill: (π/4) ∫∫ D² N(D) dD dx over the slab, the diameters in metres, less the drops
-        // narrower than MIN_IMAGE_PX (D f / x < MIN_IMAGE_PX), which are left out: a quadrature here.
-        let view = level_view(25.0, 1.0 / 500.0);
+        // narrower than MIN_IMAGE_PX (D f / x < MIN_IMAGE_PX), which are left out: a quadrature here. A frozen
+        // drop's image (this short exposure) of at least MIN_IMAGE_PX, with f = 80 px (its blur a tenth of a pixel),
+        // covers a pixel by more than MIN_COVERAGE: no other drop is left out.
+        let view = level_view(25.0, 1e-4);
         let (far, _) = view.slab();
         let lam = slope_per_mm(25.0);
         let (nd, nx) = (2_000, 400);
@@ -408,13 +452,32 @@ mod tests {
         for (i, &c) in cover.iter().enumerate() {
             if c > 0.0 {
                 let (u, v) = ((i % 160) as f32 + 0.5, (i / 160) as f32 + 0.5);
-                assert!((u - drop.at[0]).abs() <= 1.0 + drop.width_px, "{u} {drop:?}");
-                assert!((v - drop.at[1]).abs() <= 1.0 + drop.width_px + 0.5 * drop.streak[1], "{v} {drop:?}");
+                assert!((u - drop.at[0]).abs() <= 1.0 + drop.spread_px(), "{u} {drop:?}");
+                assert!((v - drop.at[1]).abs() <= 1.0 + drop.spread_px() + 0.5 * drop.streak[1], "{v} {drop:?}");
             }
         }
         // A surface nearer than the drop hides it.
         let near = vec![0.1f32; 160 * 120];
         assert!(coverage(view.size, &[drop], &near, |_| Vec3::ONE).0.iter().all(|&c| c == 0.0));
+    }
+
+    #[test]
+    fn a_long_lens_blurs_its_drops_into_the_haze() {
+        // The same sensor (640 × 480 pixels of 3.45 µm) behind a 90° lens and a 1.8° one (f = 20,000 px, an
+        // aperture of 4.9 cm at f/1.4), in the same rain at dusk (1/30 s): the wide lens draws its drops, the long
+        // lens none (each blurred over many times its image and smeared down a long streak).
+        let wide = RainView { size: (640, 480), f: 320.0, ..level_view(25.0, MAX_EXPOSURE_S) };
+        let long = RainView { f: 20_000.0, ..wide };
+        assert!(wide.drops(2).len() > 100, "{}", wide.drops(2).len());
+        assert!(long.drops(2).is_empty());
+        // A blurred drop keeps its coverage, spread over its blur.
+        let drop =
+            Drop { at: [50.0, 40.0], streak: [0.0, 0.0], width_px: 0.5, blur_px: 6.0, depth_m: 3.0, dir: Vec3::X };
+        let (cover, _) = coverage((160, 120), &[drop], &vec![f32::INFINITY; 160 * 120], |_| Vec3::ONE);
+        let area = std::f32::consts::FRAC_PI_4 * 0.25;
+        assert!((cover.iter().sum::<f32>() / area - 1.0).abs() < 1e-4);
+        assert!(cover.iter().filter(|&&c| c > 0.0).count() >= 36);
+        assert!((drop.peak_coverage() - area / 36.0).abs() < 1e-6);
     }
 
     #[test]
