@@ -42,6 +42,7 @@ __all__ = [
     "fully_developed",
     "hull_rao",
     "lidar_trace_order",
+    "marshall_palmer",
     "pinhole_intrinsics",
     "reference_usv_dims",
     "response_variance",
@@ -602,6 +603,11 @@ def wave_height(wave: str | float) -> float:
 def exposure_limits() -> dict[str, Any]:
     """The camera exposure settings' ranges: ``ev100``, ``compensation_ev``, ``max_iso`` as ``(lo, hi)`` and
     ``default_max_iso`` (the core's tonemap constants, their one definition)."""
+
+def marshall_palmer() -> tuple[float, tuple[float, float]]:
+    """The Marshall–Palmer drop-size law ``(N0, (c, e))``: ``N(D) = N0 e^(−Λ D)`` drops per m³ per mm of diameter
+    ``D`` (mm), ``Λ = c R^e`` per mm in rain of ``R`` mm/h (the core's one definition: the cameras' drops and
+    :mod:`mmusv.world.rain` read it)."""
 
 def wave_presets() -> list[tuple[str, float]]:
     """``[(name, H metres), ...]`` of the presets W0..W3 in order (the one definition of the presets)."""

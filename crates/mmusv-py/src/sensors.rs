@@ -80,8 +80,18 @@ fn exposure_limits(py: Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyDict>> {
     Ok(d)
 }
 
+/// The Marshall–Palmer drop-size law, `(N₀, (c, e))`: `N(D) = N₀ e^{−ΛD}` drops per m³ per mm of diameter `D`
+/// (mm), `Λ = c R^e` per mm in rain of `R` mm/h (mmusv_core::sensors::shade::rain: its one definition, which the
+/// cameras' drops and the visibility in rain, `mmusv.world.rain`, both read).
+#[pyfunction]
+fn marshall_palmer() -> (f64, (f64, f64)) {
+    use mmusv_core::sensors::shade::rain::{MP_LAMBDA, MP_N0};
+    (MP_N0, MP_LAMBDA)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(exposure_limits, m)?)?;
+    m.add_function(wrap_pyfunction!(marshall_palmer, m)?)?;
     m.add_function(wrap_pyfunction!(pinhole_intrinsics, m)?)?;
     m.add_function(wrap_pyfunction!(pinhole_directions, m)?)?;
     m.add_function(wrap_pyfunction!(lidar_directions, m)?)?;

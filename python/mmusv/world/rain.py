@@ -23,12 +23,17 @@ from __future__ import annotations
 
 import math
 
+from mmusv._native import core
+
 __all__ = ["MP_LAMBDA", "MP_N0", "rain_extinction_per_m", "visibility_in_rain"]
 
-MP_N0 = 8000.0
-"""Marshall–Palmer intercept ``N₀``, drops per m³ per mm of diameter."""
-MP_LAMBDA = (4.1, -0.21)
-"""Marshall–Palmer slope ``Λ = 4.1 · R^−0.21`` per mm (``R`` in mm/h): the coefficient and the exponent."""
+_MARSHALL_PALMER = core.marshall_palmer()
+MP_N0: float = _MARSHALL_PALMER[0]
+"""Marshall–Palmer intercept ``N₀``, drops per m³ per mm of diameter (8000; the core's, which draws the cameras'
+drops from the same law: ``crates/mmusv-core/src/sensors/shade/rain.rs``)."""
+MP_LAMBDA: tuple[float, float] = _MARSHALL_PALMER[1]
+"""Marshall–Palmer slope ``Λ = 4.1 · R^−0.21`` per mm (``R`` in mm/h): the coefficient and the exponent (the
+core's)."""
 
 
 def rain_extinction_per_m(rain_mm_per_h: float) -> float:
