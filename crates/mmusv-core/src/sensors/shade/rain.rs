@@ -33,7 +33,6 @@
 //!   scale `k = 1 / (1.2 · 2^EV100)` is `T = N² / 2^EV100 = 1.2 N² k`, held at 1/30 s when longer
 //!   ([`exposure_time_s`]). By day the shutter is a fraction of a millisecond and the drops are frozen dots; at dusk
 //!   the streaks grow long and faint: the dependence on exposure time Garg & Nayar measured (2007, section 5).
-//!
 //! * **Defocus.** The lens is focused at infinity, so a drop at depth `x` is blurred over a disc of `A f / x`
 //!   pixels, `A = f p / N` the aperture's diameter for a pixel pitch `p` ([`PIXEL_PITCH_M`]): its coverage is
 //!   spread over that disc where it is wider than the drop's image. A wide-angle camera's drops stay sharp (a 2 mm
@@ -51,20 +50,24 @@
 //! drop behind the surface a pixel shows (its depth beyond the pixel's) does not cover it.
 //!
 //! Checked against closed forms (the tests below): the coverage the drawn drops give, over many images, is the
-//! frustum slab's geometric optical depth `(π/4) ∫ D² N(D) dD · (x₁ − x₀)`; a drop's coverage sums to its image's
-//! area and runs along the fall's image; `T_w` is the Fresnel integral; the velocity fit is within 3 % of Gunn &
-//! Kinzer's measured table. Not modelled: the drops' oscillations and the speckle and highlights within a streak
-//! (Garg & Nayar, "Photorealistic Rendering of Rain Streaks", ACM TOG 25(3), 2006), a lens focused nearer
-//! than infinity, the blur's shape (a square of its width here, not a disc), wind and the camera's own motion (the streaks fall straight down the world's
-//! vertical), drops on the lens, the lamps' light in the drops, splashes, and an orthographic top view (its
-//! pixels are metres across: a drop covers nothing).
+//! frustum slab's geometric optical depth `(π/4) ∫∫ D² N(D) dD dx` (by quadrature, less the drops narrower than
+//! [`MIN_IMAGE_PX`]); a drop's coverage sums to its image's area, runs along the fall's image and keeps its area
+//! over its blur; a long lens draws no drop where a wide one draws hundreds; `T_w` is the Fresnel integral; the
+//! velocity fit is within 3 % of Gunn & Kinzer's measured table. Not modelled: the drops' oscillations and the
+//! speckle and highlights within a streak (Garg & Nayar, "Photorealistic Rendering of Rain Streaks", ACM TOG
+//! 25(3), 2006), a lens focused nearer than infinity, the blur's shape (a square of its width here, not a disc),
+//! wind and the camera's own motion (the streaks fall straight down the world's vertical), drops on the lens, the
+//! lamps' light in the drops, splashes, and an orthographic top view (its pixels are metres across: a drop covers
+//! nothing).
 
 use super::super::noise::{self, stream};
 use parry3d::math::{Mat3, Vec3};
 
-/// Marshall–Palmer intercept `N₀`, drops per m³ per mm of diameter (`python/mmusv/world/rain.py`'s `MP_N0`).
+/// Marshall–Palmer intercept `N₀`, drops per m³ per mm of diameter (its one definition: `mmusv.world.rain` reads it
+/// for the visibility in rain, through `_core.marshall_palmer`).
 pub const MP_N0: f64 = 8000.0;
-/// Marshall–Palmer slope `Λ = 4.1 · R^−0.21` per mm: the coefficient and the exponent (`MP_LAMBDA` there).
+/// Marshall–Palmer slope `Λ = 4.1 · R^−0.21` per mm (`R` in mm/h): the coefficient and the exponent (read there
+/// too).
 pub const MP_LAMBDA: (f64, f64) = (4.1, -0.21);
 /// The diameters of the drops drawn, mm (smaller drops are sub-pixel at every depth drawn; larger ones break up).
 pub const DIAMETER_RANGE_MM: (f64, f64) = (0.5, 6.0);
