@@ -465,6 +465,26 @@ mod tests {
     }
 
     #[test]
+    fn a_rolled_camera_sees_the_rain_fall_at_its_roll() {
+        // Rolled 30° about its optical axis (not pitched; its left side up), the camera sees the world's vertical
+        // as parallel lines turned 30° from its columns, down and to the right, and every streak along them.
+        let roll = 30f32.to_radians();
+        let level = level_view(25.0, 1.0 / 60.0);
+        let view = RainView { rotation: level.rotation * Mat3::from_rotation_x(roll), ..level };
+        let mut seen = 0;
+        for seed in 0..8 {
+            for d in view.drops(seed) {
+                if d.streak[0].hypot(d.streak[1]) > 1.0 {
+                    let angle = d.streak[0].atan2(d.streak[1]);
+                    assert!((angle - roll).abs() < 1e-3, "{angle} {d:?}");
+                    seen += 1;
+                }
+            }
+        }
+        assert!(seen > 20, "{seen}");
+    }
+
+    #[test]
     fn a_long_lens_blurs_its_drops_into_the_haze() {
         // The same sensor (640 × 480 pixels of 3.45 µm) behind a 90° lens and a 1.8° one (f = 20,000 px, an
         // aperture of 4.9 cm at f/1.4), in the same rain at dusk (1/30 s): the wide lens draws its drops, the long
