@@ -492,13 +492,13 @@ impl Camera {
             // Lamps smaller than a pixel, from the lamps themselves (`camera/lamp_points.rs`).
             self.add_lamp_points(scene, pose, &shader, (&frame, &mut linear))?;
         }
-        if let (Projection::Pinhole { hfov }, true) = (self.cfg.projection, env.rain_mm_per_h > 0.0) {
+        if let (Some([f, ..]), true) = (self.intrinsics(), env.rain_mm_per_h > 0.0) {
             // The drops near the lens (`shade/rain.rs`), in the exposure the camera metered.
             let view = RainView {
                 size: (self.cfg.width, self.cfg.height),
-                f: (f64::from(self.cfg.width) / (2.0 * (0.5 * hfov).tan())) as f32,
+                f: f as f32,
                 rotation: pose.rotation,
-                exposure_s: rain::exposure_time_s(k),
+                exposure_s: tonemap::exposure_time_s(k),
                 rain_mm_per_h: env.rain_mm_per_h,
             };
             let drops = view.drops(options.seed);

@@ -31,7 +31,7 @@
 //!   A drop's streak is its image's motion over the exposure, at its mid-exposure position (pinhole projection).
 //! * **The exposure time.** The camera of `tonemap.rs` (f/1.4, at most 1/30 s, then gain): at ISO 100 an exposure
 //!   scale `k = 1 / (1.2 · 2^EV100)` is `T = N² / 2^EV100 = 1.2 N² k`, held at 1/30 s when longer
-//!   ([`exposure_time_s`]). By day the shutter is a fraction of a millisecond and the drops are frozen dots; at dusk
+//!   ([`super::tonemap::exposure_time_s`]). By day the shutter is a fraction of a millisecond and the drops are frozen dots; at dusk
 //!   the streaks grow long and faint: the dependence on exposure time Garg & Nayar measured (2007, section 5).
 //! * **Defocus.** The lens is focused at infinity, so a drop at depth `x` is blurred over a disc of `A f / x`
 //!   pixels, `A = f p / N` the aperture's diameter for a pixel pitch `p` ([`PIXEL_PITCH_M`]): its coverage is
@@ -61,6 +61,7 @@
 //! nothing).
 
 use super::super::noise::{self, stream};
+use super::tonemap::F_NUMBER;
 use parry3d::math::{Mat3, Vec3};
 
 /// Marshall–Palmer intercept `N₀`, drops per m³ per mm of diameter (its one definition: `mmusv.world.rain` reads it
@@ -77,10 +78,6 @@ pub const NEAR_M: f64 = 0.2;
 pub const FAR_IMAGE_PX: f64 = 0.25;
 /// The most drops drawn for one image (the far limit comes nearer for a long focal length in heavy rain).
 pub const MAX_DROPS: f64 = 200_000.0;
-/// The camera's aperture, f-number (`tonemap.rs`).
-pub const F_NUMBER: f32 = 1.4;
-/// The camera's longest exposure, seconds (`tonemap.rs`: its frame time).
-pub const MAX_EXPOSURE_S: f32 = 1.0 / 30.0;
 /// A drop's transmittance `(1 − R̄)²`, `R̄ = 2 ∫₀^{π/2} F(θ) cos θ sin θ dθ` the cosine-weighted hemispherical mean
 /// of the Fresnel reflectance of water (n = 1.333, unpolarised light), 0.0662: light enters and leaves the drop
 /// through one surface each (the test below integrates it).
@@ -100,12 +97,6 @@ const MAX_STEPS: usize = 4096;
 /// Atlas et al. 1973's fit; 0 for a drop too small for the fit).
 pub fn terminal_velocity_m_s(d_mm: f64) -> f64 {
     (9.65 - 10.3 * (-0.6 * d_mm).exp()).max(0.0)
-}
-
-/// The exposure time (s) of the camera whose exposure scale (radiance to the tone curve's input) is `k`: `1.2 N² k`
-/// at ISO 100 and f/[`F_NUMBER`], at most [`MAX_EXPOSURE_S`].
-pub fn exposure_time_s(k: f32) -> f32 {
-    (1.2 * F_NUMBER * F_NUMBER * k).clamp(0.0, MAX_EXPOSURE_S)
 }
 
 /// Marshall–Palmer slope `Λ` (per mm) of rain of `rain_mm_per_h`.
@@ -143,7 +134,7 @@ pub struct RainView {
     pub f: f32,
     /// Camera body → world rotation (body x forward, y left, z up; image `u` right, `v` down).
     pub rotation: Mat3,
-    /// Exposure time, seconds ([`exposure_time_s`]).
+    /// Exposure time, seconds ([`super::tonemap::exposure_time_s`]).
     pub exposure_s: f32,
     /// Rain rate, mm/h.
     pub rain_mm_per_h: f32,
@@ -167,6 +158,16 @@ pub struct Drop {
 }
 
 impl Drop {
+    /// The area of its image, pixels².
+    pub fn area_px2(&self) -> f32 {
+        std::f32::consts::FRAC_PI_4 * self.width_px * self.width_px
+    }
+
+    /// The length of its streak, pixels.
+    pub fn streak_px(&self) -> f32 {
+        self.streak[0].hypot(self.streak[1])
+    }
+
     /// The diameter (pixels) its coverage is spread over across its path: its image's or its blur's, the wider.
     pub fn spread_px(&self) -> f32 {
         self.width_px.max(self.blur_px)
@@ -176,9 +177,7 @@ impl Drop {
     /// across the pixel, the spread at least a pixel wide, for the share of the exposure it stays there).
     pub fn peak_coverage(&self) -> f32 {
         let spread = self.spread_px().max(1.0);
-        let len = self.streak[0].hypot(self.streak[1]);
-        let area = std::f32::consts::FRAC_PI_4 * self.width_px * self.width_px;
-        area / (spread * spread) * (spread / len.max(spread)).min(1.0)
+        self.area_px2() / (spread * spread) * (spread / self.streak_px().max(spread)).min(1.0)
     }
 }
 
@@ -263,21 +262,18 @@ pub fn coverage(
     }
     for drop in drops {
         let l_d = radiance(drop);
-        let area = std::f32::consts::FRAC_PI_4 * drop.width_px * drop.width_px;
-        let len = drop.streak[0].hypot(drop.streak[1]);
         // Steps of at most a pixel along the streak (each splat bilinear), sub-steps of about a pixel across a wide
-        // image.
-        let steps = ((len.ceil() as usize) + 1).clamp(1, MAX_STEPS);
+        // image (one, at the centre, for a drop narrower than a pixel).
+        let steps = (drop.streak_px().ceil() as usize + 1).min(MAX_STEPS);
         let spread = drop.spread_px();
         let side = (spread.ceil() as usize).clamp(1, 16);
-        let share = area / (steps * side * side) as f32;
+        let offsets: Vec<f32> = (0..side).map(|k| ((k as f32 + 0.5) / side as f32 - 0.5) * spread).collect();
+        let share = drop.area_px2() / (steps * side * side) as f32;
         for s in 0..steps {
             let t = if steps == 1 { 0.0 } else { s as f32 / (steps - 1) as f32 - 0.5 };
-            for a in 0..side {
-                for b in 0..side {
-                    let off = |k: usize| ((k as f32 + 0.5) / side as f32 - 0.5) * spread;
-                    let pu = drop.at[0] + t * drop.streak[0] + if side > 1 { off(a) } else { 0.0 };
-                    let pv = drop.at[1] + t * drop.streak[1] + if side > 1 { off(b) } else { 0.0 };
+            for &ou in &offsets {
+                for &ov in &offsets {
+                    let (pu, pv) = (drop.at[0] + t * drop.streak[0] + ou, drop.at[1] + t * drop.streak[1] + ov);
                     splat(&mut cover, &mut light, (w, h), (pu, pv), share, l_d, drop.depth_m, depth);
                 }
             }
@@ -337,6 +333,7 @@ pub fn apply(background: Vec3, cover: f32, light: Vec3) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::super::brdf::fresnel_dielectric;
+    use super::super::tonemap::MAX_EXPOSURE_S;
     use super::*;
 
     fn level_view(rain: f32, exposure_s: f32) -> RainView {
@@ -365,14 +362,6 @@ mod tests {
             let fit = terminal_velocity_m_s(d);
             assert!((fit / v - 1.0).abs() < 0.03, "{d} mm: {fit} against {v}");
         }
-    }
-
-    #[test]
-    fn the_exposure_time_is_the_cameras() {
-        // A fixed EV100 of 15 (full sun) at f/1.4: N² / 2^15 s; EV100 0 would be 1.96 s, held at 1/30 s.
-        let k = |ev: f32| 1.0 / (1.2 * 2f32.powf(ev));
-        assert!((exposure_time_s(k(15.0)) - 1.96 / 32_768.0).abs() < 1e-9);
-        assert_eq!(exposure_time_s(k(0.0)), MAX_EXPOSURE_S);
     }
 
     #[test]

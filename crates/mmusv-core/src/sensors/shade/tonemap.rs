@@ -35,6 +35,18 @@ use parry3d::math::Vec3;
 /// of the next fifty minutes darkened with the light itself, 550-fold by 21:15.
 pub const MIN_METERED_LUX: f32 = 3.46;
 
+/// The camera's aperture, f-number (fixed: the automatic exposure sets the time, then the gain).
+pub const F_NUMBER: f32 = 1.4;
+/// The camera's longest exposure, seconds (its frame time): darker, the gain rises instead.
+pub const MAX_EXPOSURE_S: f32 = 1.0 / 30.0;
+
+/// The exposure time (s) of the camera whose exposure scale (radiance to the tone curve's input) is `k`: at
+/// ISO 100, `k = 1 / (1.2 · 2^EV100)` ([`fixed_exposure_scale`]) is `T = N² / 2^EV100 = 1.2 N² k` at
+/// f/[`F_NUMBER`], held at [`MAX_EXPOSURE_S`] where longer (the gain makes up the rest).
+pub fn exposure_time_s(k: f32) -> f32 {
+    (1.2 * F_NUMBER * F_NUMBER * k).clamp(0.0, MAX_EXPOSURE_S)
+}
+
 /// The highest ISO of the default camera's automatic exposure, whose limit is [`MIN_METERED_LUX`].
 pub const DEFAULT_MAX_ISO: f32 = 6_400.0;
 
@@ -292,7 +304,7 @@ mod tests {
     /// EV100 (within the floor's rounding to three figures, 0.2 %); above it the incident reading still governs.
     #[test]
     fn the_exposure_floor_is_the_low_light_cameras_limit() {
-        let ev100 = (1.4f32 * 1.4 * 30.0).log2() - (6_400.0f32 / 100.0).log2();
+        let ev100 = (F_NUMBER * F_NUMBER / MAX_EXPOSURE_S).log2() - (6_400.0f32 / 100.0).log2();
         assert!((ev100 + 0.12).abs() < 0.01, "{ev100}");
         let limit = exposure_scale(ev100, 0.0);
         for lux in [0.0, 1e-3, 0.08, 0.5, 3.0, MIN_METERED_LUX] {
@@ -303,6 +315,14 @@ mod tests {
         assert!((exposure_scale(f32::NAN, 20.0) * 20.0 - std::f32::consts::PI).abs() < 1e-5);
     }
 
+    /// The exposure time is the exposure value's at f/1.4: a fixed EV100 of 15 (full sun) gives N² / 2^15 s;
+    /// EV100 0 would be 1.96 s, held at 1/30 s.
+    #[test]
+    fn the_exposure_time_is_the_cameras() {
+        assert!((exposure_time_s(fixed_exposure_scale(15.0)) - 1.96 / 32_768.0).abs() < 1e-9);
+        assert_eq!(exposure_time_s(fixed_exposure_scale(0.0)), MAX_EXPOSURE_S);
+    }
+
     /// A camera's highest ISO sets its floor as the same f/1.4, 1/30 s limit at that ISO (one stop of gain, one
     /// stop of light), the default camera's exactly [`MIN_METERED_LUX`]; settings out of range are refused,
     /// naming the field.
@@ -310,7 +330,7 @@ mod tests {
     fn the_floor_follows_the_highest_iso_and_settings_are_checked() {
         assert_eq!(min_metered_lux(DEFAULT_MAX_ISO), MIN_METERED_LUX);
         for iso in [400.0f32, 1_600.0, 25_600.0, 102_400.0] {
-            let ev100 = (1.4f32 * 1.4 * 30.0).log2() - (iso / 100.0).log2();
+            let ev100 = (F_NUMBER * F_NUMBER / MAX_EXPOSURE_S).log2() - (iso / 100.0).log2();
             let limit = fixed_exposure_scale(ev100);
             let k = incident_exposure_scale(0.0, min_metered_lux(iso));
             assert!((k / limit - 1.0).abs() < 0.002, "ISO {iso}: {k} against {limit}");
