@@ -9,6 +9,7 @@ is the visibility's (``mmusv.world.rain``), which these scenes fix, so the rain 
 from __future__ import annotations
 
 import copy
+import functools
 from typing import Any
 
 import mmusv
@@ -44,13 +45,18 @@ _SCENE: dict[str, Any] = {
 }
 
 
+@functools.cache
 def _rgb(time_of_day: str, rain_mm_per_h: float) -> np.ndarray:
+    """The camera's RGB, int16 ``(H, W, 3)``, read-only: rendered once per time and rain for the module (the dry
+    pictures serve several tests)."""
     scene = copy.deepcopy(_SCENE)
     scene["environment"].update(time_of_day=time_of_day, rain_mm_per_h=rain_mm_per_h)
     sim = mmusv.Simulation(scene)
     rgb = sim.capture(0, sensors=["cameras"]).agents["observer"].cameras["view"].rgb
     assert rgb is not None
-    return np.asarray(rgb).astype(np.int16)
+    out = np.asarray(rgb).astype(np.int16)
+    out.flags.writeable = False
+    return out
 
 
 def _change(time_of_day: str, rain_mm_per_h: float) -> np.ndarray:
