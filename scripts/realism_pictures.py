@@ -103,6 +103,30 @@ def _save_rgb(scenario: dict[str, Any], path: Path) -> None:
     Image.fromarray(np.asarray(rgb)).save(path)
 
 
+def _times_sheet(
+    path: Path,
+    name: str,
+    *,
+    rig: dict[str, Any],
+    vessels: list[dict[str, Any]],
+    environment: dict[str, Any],
+    times: list[str],
+) -> None:
+    """One scene at several times of day (``environment`` without its ``time_of_day``), 480 × 270 each, three a row
+    in the order given, written to ``path``."""
+    from PIL import Image
+
+    rows = (len(times) + 2) // 3
+    sheet = Image.new("RGB", (min(len(times), 3) * 480, rows * 270))
+    with tempfile.TemporaryDirectory(prefix="realism_") as tmp:
+        for i, t in enumerate(times):
+            one = Path(tmp) / f"{i}.png"
+            _save_rgb(_scenario(name, rig=rig, vessels=vessels, environment={"time_of_day": t, **environment}), one)
+            with Image.open(one) as im:
+                sheet.paste(im, ((i % 3) * 480, (i // 3) * 270))
+    sheet.save(path)
+
+
 # ---------------------------------------------------------------------------------------------------- views
 
 
@@ -233,21 +257,14 @@ def night_fog(path: Path) -> None:
 def dusk_series(path: Path) -> None:
     """``ferry_dusk``'s ferry and view at six times through the hour of dusk (19:45, 20:15, 20:30 above; 20:45,
     21:00, 21:15 below), 480 × 270 each, side by side."""
-    from PIL import Image
 
     bearing = 140.0
     x, y = _at(bearing, 120.0)
     ferry = {"id": "ferry", "asset": "ropax_ferry_90m", "speed_mps": 6.0, "route": _route(x, y, 265.0)}
     rig = _camera_rig(resolution=(480, 270), hfov_deg=60.0, xyz=(0.0, 0.0, 3.0), yaw_deg=bearing, pitch_deg=-5.0)
-    sheet = Image.new("RGB", (3 * 480, 2 * 270))
-    with tempfile.TemporaryDirectory(prefix="realism_") as tmp:
-        for i, t in enumerate(["19:45", "20:15", "20:30", "20:45", "21:00", "21:15"]):
-            env = {"time_of_day": t, "weather": "clear", "wave": "W1"}
-            one = Path(tmp) / f"{i}.png"
-            _save_rgb(_scenario("dusk_series", rig=rig, vessels=[ferry], environment=env), one)
-            with Image.open(one) as im:
-                sheet.paste(im, ((i % 3) * 480, (i // 3) * 270))
-    sheet.save(path)
+    env = {"weather": "clear", "wave": "W1"}
+    times = ["19:45", "20:15", "20:30", "20:45", "21:00", "21:15"]
+    _times_sheet(path, "dusk_series", rig=rig, vessels=[ferry], environment=env, times=times)
 
 
 def exposure_settings(path: Path) -> None:
@@ -285,20 +302,12 @@ def whitecaps_w3(path: Path) -> None:
 def rain(path: Path) -> None:
     """A tug under way (2 m/s), 60 m off, in heavy rain (25 mm/h, the visibility the drops leave) at 12:00, 20:00
     and 23:00 on 21 June at 45° N, from 3 m above the sea: 480 × 270 each, side by side."""
-    from PIL import Image
 
     bearing = 100.0
     tug = {"id": "tug", "asset": "tug_32m", "speed_mps": 2.0, "route": _route(*_at(bearing, 60.0), 180.0)}
     rig = _camera_rig(resolution=(480, 270), hfov_deg=70.0, xyz=(0.0, 0.0, 3.0), yaw_deg=bearing, pitch_deg=-4.0)
-    sheet = Image.new("RGB", (3 * 480, 270))
-    with tempfile.TemporaryDirectory(prefix="realism_") as tmp:
-        for i, t in enumerate(["12:00", "20:00", "23:00"]):
-            env = {"time_of_day": t, "weather": "rain", "rain_mm_per_h": 25.0, "wave": "W1"}
-            one = Path(tmp) / f"{i}.png"
-            _save_rgb(_scenario("rain", rig=rig, vessels=[tug], environment=env), one)
-            with Image.open(one) as im:
-                sheet.paste(im, (i * 480, 0))
-    sheet.save(path)
+    env = {"weather": "rain", "rain_mm_per_h": 25.0, "wave": "W1"}
+    _times_sheet(path, "rain", rig=rig, vessels=[tug], environment=env, times=["12:00", "20:00", "23:00"])
 
 
 _FAST = {"id": "fast", "asset": "patrol_boat_35m", "speed_mps": 14.0, "route": _route(0.0, 0.0, 90.0, 4000.0)}
