@@ -1,10 +1,12 @@
 //! Bindings for `mmusv_core::sensors::capture`: every sensor of a frame in one call, GIL released.
 
+use crate::camera::{frame_dict, Camera};
 use crate::errors::InputError;
+use crate::lidar::{scan_dict, Lidar};
 use crate::native::{detached, pose_arg};
 use crate::radar::{returns_dict, Radar};
 use crate::scene::Scene;
-use crate::sensors::{frame_dict, scan_dict, Camera, Lidar, SensorEnv};
+use crate::shade::SensorEnv;
 use mmusv_core::sensors::capture::{self, PpiRequest, SensorOutput, SensorTask};
 use mmusv_core::sensors::ppi::{PpiConfig, PpiOrientation};
 use mmusv_core::RigidPose;
@@ -88,7 +90,7 @@ fn capture_frame<'py>(
     tasks: Vec<Bound<'py, PyAny>>,
     wakes: Option<numpy::PyReadonlyArray2<'py, f32>>,
 ) -> PyResult<Bound<'py, PyList>> {
-    let wakes = crate::sensors::wakes_arg(wakes.as_ref())?;
+    let wakes = crate::shade::wakes_arg(wakes.as_ref())?;
     let items = tasks.iter().enumerate().map(|(i, t)| parse_item(i, t)).collect::<PyResult<Vec<_>>>()?;
     let core_tasks = items.iter().enumerate().map(|(i, it)| task(i, it)).collect::<PyResult<Vec<_>>>()?;
     let shade = &env.shade;

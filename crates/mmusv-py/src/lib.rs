@@ -6,16 +6,19 @@
 
 use pyo3::prelude::*;
 
+mod camera;
 mod capture;
 mod demo;
 mod errors;
 mod kinematics;
+mod lidar;
 mod native;
 mod ocean;
 mod radar;
+mod rays;
 mod record;
 mod scene;
-mod sensors;
+mod shade;
 mod simd;
 
 /// The compiled core of mmusv. Use the `mmusv` package rather than this module directly.
@@ -29,7 +32,10 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     scene::register(m)?;
     kinematics::register(m)?;
     ocean::register(m)?;
-    sensors::register(m)?;
+    rays::register(m)?;
+    shade::register(m)?;
+    lidar::register(m)?;
+    camera::register(m)?;
     radar::register(m)?;
     capture::register(m)?;
     record::register(m)?;

@@ -4,7 +4,7 @@
 use crate::errors::to_py;
 use crate::native::{detached, flat, pose_arg};
 use crate::scene::Scene;
-use crate::sensors::SensorEnv;
+use crate::shade::SensorEnv;
 use mmusv_core::sensors::capture;
 use mmusv_core::sensors::ppi::{self, PpiConfig, PpiOrientation};
 use mmusv_core::sensors::radar::sea_clutter::Polarisation;
