@@ -4,7 +4,8 @@
   ``RaycastingScene`` built from ``Scene.world_mesh()`` (an independent ray caster): ranges agree to 1 cm, the
   face hit belongs to the point's instance, rays without a point are misses there.
 * Pattern bookkeeping: ring / azimuth / ray_index / elevation of each point, explicit elevation tables.
-* Noise model: seeding, Gaussian range noise, dropout, water returns versus wave height, fog losses, and the
+* Noise model: seeding, Gaussian range noise, dropout, water returns versus wave height, fog losses (rain's
+  through its visibility alone), and the
   intensity formula ``ρ(class) · |cos θ| · τ / (1 + (r / 100 m)²)``, checked analytically on simple scenes
   (a closed room whose every ray hits, a lone water plane).
 """
@@ -23,6 +24,7 @@ from mmusv.scene import Scene, demo_scene
 from mmusv.sensors import LidarConfig, LidarPoints, lidar_from_config, scan, sensor_env
 from mmusv.simulation import Simulation
 from mmusv.world.build import pose_matrices
+from mmusv.world.environment import Weather
 
 # Room used by the noise tests: every ray of a ±25°..15° pattern from the origin hits one of its walls.
 ROOM_LO = (-120.0, -25.0, -8.0)
@@ -401,16 +403,34 @@ def test_fog_drops_far_returns_by_two_way_transmission() -> None:
         assert abs(got - expect) < 4.5 * sd + 1e-9, f"{lo}-{hi} m: kept {got:.3f}, expected {expect:.3f}"
         rates.append(got)
     assert rates == sorted(rates, reverse=True) and rates[-1] < 0.5 * rates[0]
-    # Rain attenuates too (σ = 1e-5·R^0.6 per metre): heavy rain loses a few far returns, never adds any.
-    rainy = do_scan(lidar, room_scene(), seed=5, rain_mm_per_h=100.0)
-    assert np.isin(rainy.ray_index, clear.ray_index).all() and len(rainy) < len(clear)
 
 
-@pytest.mark.parametrize("fog", [0.0, 0.004])
-def test_intensity_formula(fog: float) -> None:
+def test_rain_dims_the_lidar_through_the_visibility_alone() -> None:
+    """The drops extinguish 905 nm as they do visible light, and the visibility in rain holds them
+    (:mod:`mmusv.world.rain`): a LiDAR in 50 mm/h loses the returns that the rain's visibility loses, and the rain
+    rate adds no second loss (until 2026-12-07 an unsourced ``1e-5·R^0.6`` per metre was added to the visibility's
+    extinction, the drops counted twice: the scans differed)."""
+    weather = Weather.make("rain", rain_mm_per_h=50.0)
+    sigma = weather.extinction_per_m
+    assert 2.5e-3 < sigma < 6e-3  # the drops alone: 0.365·50^0.63 per km, 4.1e-3 per metre; and the air's
+    lidar = exact_lidar(32, 720)
+    clear = do_scan(lidar, room_scene(), seed=5)
+    in_rain = do_scan(lidar, room_scene(), seed=5, fog_extinction_per_m=sigma, rain_mm_per_h=50.0)
+    same_air = do_scan(lidar, room_scene(), seed=5, fog_extinction_per_m=sigma)
+    np.testing.assert_array_equal(in_rain.ray_index, same_air.ray_index)
+    np.testing.assert_array_equal(in_rain.intensity, same_air.intensity)
+    assert np.isin(in_rain.ray_index, clear.ray_index).all() and len(in_rain) < 0.8 * len(clear)
+    # The rain rate without its visibility (clear air) dims nothing.
+    rate_alone = do_scan(lidar, room_scene(), seed=5, rain_mm_per_h=100.0)
+    np.testing.assert_array_equal(rate_alone.intensity, clear.intensity)
+
+
+@pytest.mark.parametrize(("fog", "rain"), [(0.0, 0.0), (0.004, 0.0), (0.004, 50.0)])
+def test_intensity_formula(fog: float, rain: float) -> None:
+    """``τ = exp(−2σr)`` with σ the visibility's extinction alone, in rain too (its drops are in the visibility)."""
     lidar = exact_lidar(32, 360)
     pose = pose_matrices(np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.0]))
-    pts = do_scan(lidar, room_scene(), pose, seed=2, fog_extinction_per_m=fog)
+    pts = do_scan(lidar, room_scene(), pose, seed=2, fog_extinction_per_m=fog, rain_mm_per_h=rain)
     pat = np.asarray(lidar.pattern(), dtype=np.float64)
     truth, cos = room_truth(pat)
     r = truth[pts.ray_index]

@@ -229,7 +229,7 @@ def _check_flat_water_model(sim: Simulation, agent_id: str) -> None:
     assert n > 500 and abs(k - n * p) < 4.5 * math.sqrt(n * p * (1 - p)), f"{k} water returns of {n} rays, p = {p}"
     # Other surfaces return unless the (clear, 20 km visibility) air loses them: probability exp(−2σr).
     solid = (hits.semantic_class != 1) & np.isfinite(hits.distance) & (hits.distance >= cfg.range_min_m)
-    sigma = sim.environment.weather.extinction_per_m + 1e-5 * sim.environment.weather.rain_mm_per_h**0.6
+    sigma = sim.environment.weather.extinction_per_m  # rain's drops, when it rains, are in the visibility
     tau = np.exp(-2 * sigma * hits.distance[solid].astype(np.float64))
     kept = np.isin(np.flatnonzero(solid), ac.lidar.ray_index)
     assert abs(kept.sum() - tau.sum()) <= 4.5 * math.sqrt(np.sum(tau * (1 - tau))) + 1

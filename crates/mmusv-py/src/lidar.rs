@@ -63,8 +63,8 @@ impl Lidar {
         rows_to_array(py, self.inner.pattern().to_vec())
     }
 
-    /// One sweep on the current state of `scene` from the LiDAR at `pose` (4×4 LiDAR → world) in `env` (fog, rain
-    /// and waves are used). Returns a dict
+    /// One sweep on the current state of `scene` from the LiDAR at `pose` (4×4 LiDAR → world) in `env` (the fog
+    /// extinction, the rain's drops included, waves and wind are used). Returns a dict
     /// of equal-length columns: xyz (N,3) f32 LiDAR frame, range, intensity (f32), ring (u16), azimuth (f32
     /// rad), class (u16), instance (i32), ray_index (u32); and beam_instance (M,) i32: per ray of the full
     /// pattern, the instance its cast met first within the range (-1: none). `wakes` (K, 6) to (K, 9) float32

@@ -39,8 +39,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     Ok(())
 }
 
-/// What every sensor sees of the environment at a frame: sun and sky (cameras), fog (cameras, LiDAR), rain
-/// and waves (all three). Built once per scenario from the resolved environment; passed to every
+/// What every sensor sees of the environment at a frame: sun and sky (cameras), the fog extinction, the rain's
+/// drops included (cameras, LiDAR), the rain rate (the cameras' near drops, the radar) and waves (all three). Built once per scenario from the resolved environment; passed to every
 /// `Lidar.scan`, `Camera.render` and `Radar.sweep`.
 #[pyclass(frozen, module = "mmusv._core")]
 pub struct SensorEnv {
@@ -71,7 +71,7 @@ fn env_fraction(field: &str, value: f32) -> PyResult<f32> {
 }
 
 impl SensorEnv {
-    /// The LiDAR's share: fog, rain, waves.
+    /// The LiDAR's share: the fog extinction (rain's drops included), waves, wind.
     pub(crate) fn lidar(&self) -> lidar::LidarEnv {
         capture::lidar_env(&self.shade)
     }

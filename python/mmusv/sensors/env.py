@@ -5,8 +5,8 @@ From a resolved :class:`~mmusv.world.environment.Environment`: the direction tow
 below the horizon at night), the air's turbidity, the cloud cover, fog extinction σ = 3 / visibility (1/m),
 rain (mm/h), the significant wave height H (m), the wind and the water's colour. The cameras turn these into
 radiance with the physical models of the core (Preetham sky, ESRA sun, GGX surfaces, Cox–Munk water,
-Monahan whitecaps: ``crates/mmusv-core/src/sensors/shade/``); the LiDAR uses fog, rain and waves; the radar rain
-and waves.
+Monahan whitecaps: ``crates/mmusv-core/src/sensors/shade/``); the LiDAR uses the fog extinction (the visibility's, the
+rain's drops included), the waves and the wind; the radar the rain rate and the waves.
 
 * **Turbidity** from the meteorological visibility ``V``: ``T = 1.9 + 30 / V_km``, clamped to [1.9, 10], a
   monotone mapping chosen so that a clear 20 km day is T ≈ 3.4 and a 5 km haze T ≈ 7.9 (the range over which

@@ -102,7 +102,8 @@ def scan(
     wakes: npt.ArrayLike | None = None,
 ) -> LidarPoints:
     """One sweep of ``lidar`` (from :func:`lidar_from_config`) at ``pose`` (``(4, 4)`` LiDAR → world) on the
-    current state of ``scene`` in ``env`` (:func:`mmusv.sensors.env.sensor_env`: fog, rain and waves are used).
+    current state of ``scene`` in ``env`` (:func:`mmusv.sensors.env.sensor_env`: the fog extinction, the rain's drops
+    included, the waves and the wind are used).
     ``seed`` drives noise, dropout and water returns. ``wakes``: ``(K, 6)`` to ``(K, 9)`` rows ``x, y,
     heading, speed, length, beam[, reach_m[, age_s[, displacement_m3]]]`` (world metres, radians, m/s, s, m³;
     :meth:`mmusv.simulation.Simulation.wakes`, :func:`mmusv.sensors.env.wake_rows`) of the vessels under way: over

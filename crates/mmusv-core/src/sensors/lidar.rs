@@ -23,21 +23,17 @@
 //!    `p_w = water_probability + water_probability_per_wave_m · H` (clamped to 1) and only within
 //!    `water_range_m + water_range_per_wave_m · H` — calm water is a mirror at 905 nm, waves give the beam facets
 //!    to return from;
-//! 4. weather: two-way transmission `τ = exp(−2 (σ_fog + σ_rain) r)` with `σ_fog` the visibility extinction
-//!    (Koschmieder, 3 / V) and `σ_rain = 1e-5 · R^0.6` per metre (R in mm/h). The rain term has no source
-//!    (an outside re-check of 2026-12-02 found none) and is small on purpose: the
-//!    visibility `V` is the meteorological optical range in the scenario's air, rain included, and the drops,
-//!    far larger than the wavelength, extinguish 905 nm as they do visible light (geometric optics, extinction
-//!    efficiency 2: with Marshall & Palmer's 1948 drop sizes `≈ 0.365 · R^0.63` per km, 1.6 km⁻¹ at 10 mm/h,
-//!    a visibility of 1.9 km from the rain alone), so `3 / V` carries the rain's extinction when the visibility
-//!    given is the one in that rain, and this term adds 2.4–2.7 % of the drops' own extinction over 1–50 mm/h
-//!    (kept: it is in every recording made in rain). The same numbers, `0.01 · R^0.6`, are the rain extinction
-//!    that the LISA code (Kilic et al. 2021, "Lidar Light Scattering Augmentation (LISA)", arXiv:2107.07004;
-//!    `velatkilic/LISA`, `python_old/atmos_models.py`, `msu_rain`) attributes to Goodin, Carruth, Doude & Hudson
-//!    (2019), "Predicting the Influence of Rain on LIDAR in ADAS", Electronics 8(1), 89, and applies per metre
-//!    (1000 times ours: 0.04 m⁻¹ at 10 mm/h, a visibility of 75 m from the rain alone); Goodin et al.'s own text
-//!    was not read, so neither that paper as the source nor its unit is confirmed. The return is lost with
-//!    probability `1 − τ` — but for the physical water returns of step 3, whose speckle threshold already met the
+//! 4. weather: two-way transmission `τ = exp(−2 σ r)` with `σ` the air's extinction from its visibility
+//!    (Koschmieder, 3 / V). The visibility `V` is the meteorological optical range in the scenario's air, rain
+//!    included (`mmusv.world.rain`), and the drops, far larger than the wavelength, extinguish 905 nm as they do
+//!    visible light (geometric optics, extinction efficiency 2: with Marshall & Palmer's 1948 drop sizes
+//!    `≈ 0.365 · R^0.63` per km, 1.6 km⁻¹ at 10 mm/h), so `3 / V` carries the rain's extinction and the rain rate
+//!    itself adds nothing here. Until 2026-12-07 a second rain term `1e-5 · R^0.6` per metre, without a source,
+//!    was added to `σ` (2.4–2.7 % of the drops' own extinction over 1–50 mm/h, counted twice); the same numbers,
+//!    `0.01 · R^0.6`, are the rain extinction that the LISA code (Kilic et al. 2021, arXiv:2107.07004,
+//!    `velatkilic/LISA`) attributes to Goodin et al. (2019), Electronics 8(1), 89, applied per metre. Not
+//!    modelled: the returns of the drops themselves near the sensor (LISA's), which a real LiDAR reports in
+//!    heavy rain. The return is lost with probability `1 − τ` — but for the physical water returns of step 3, whose speckle threshold already met the
 //!    attenuated mean `τ ⟨I⟩` (until 2026-12-01 they were lost with probability `1 − τ` as well, the fog counted
 //!    twice: at 600 m visibility a fifth fewer water returns 20 m out than the model gives, a third 40 m out);
 //! 5. random dropout with probability `dropout`;
@@ -176,10 +172,9 @@ impl LidarConfig {
 /// Conditions that change what a LiDAR sees. Every field finite and `>= 0` ([`LidarEnv::validate`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct LidarEnv {
-    /// Atmospheric extinction coefficient (1/m), 3 / visibility.
+    /// Atmospheric extinction coefficient (1/m), 3 / visibility: fog and rain's drops alike (the visibility is the
+    /// one in the rain).
     pub fog_extinction_per_m: f32,
-    /// Rain rate (mm/h).
-    pub rain_mm_per_h: f32,
     /// Significant wave height H (m).
     pub wave_height_m: f32,
     /// Wind speed at 10 m (m/s): capillary roughness and whitecaps of the physical water returns.
@@ -191,7 +186,6 @@ impl LidarEnv {
     pub fn validate(&self) -> Result<()> {
         for (name, v) in [
             ("lidar.fog_extinction_per_m", self.fog_extinction_per_m),
-            ("lidar.rain_mm_per_h", self.rain_mm_per_h),
             ("lidar.wave_height_m", self.wave_height_m),
             ("lidar.wind_speed_m_s", self.wind_speed_m_s),
         ] {
@@ -331,7 +325,7 @@ impl Lidar {
         let h = env.wave_height_m.max(0.0);
         let p_water = (cfg.water_probability + cfg.water_probability_per_wave_m * h).clamp(0.0, 1.0) as f64;
         let water_range = cfg.water_range_m + cfg.water_range_per_wave_m * h;
-        let sigma = env.fog_extinction_per_m.max(0.0) + 1e-5 * env.rain_mm_per_h.max(0.0).powf(0.6);
+        let sigma = env.fog_extinction_per_m.max(0.0);
         let waves = scene.wave_surface().is_some();
         // Both water probabilities 0: no water returns, on the physical sea too (whose model otherwise ignores them).
         let water_off = cfg.water_probability == 0.0 && cfg.water_probability_per_wave_m == 0.0;
@@ -350,7 +344,7 @@ impl Lidar {
                 continue;
             }
             let idx = i as u64;
-            // Clear air (no fog, no rain) transmits all: `exp(-0)` is 1 to the bit, without the call per beam.
+            // Clear air (no fog, no rain: `σ` 0) transmits all: `exp(-0)` is 1 to the bit, without the call per beam.
             let tau = if sigma > 0.0 { (-2.0 * sigma * r).exp() } else { 1.0 };
             let n = Vec3::new(hits.normal[3 * k], hits.normal[3 * k + 1], hits.normal[3 * k + 2]);
             let cos = n.dot(Vec3::from_array(dirs[k])).abs().min(1.0);
@@ -538,12 +532,7 @@ mod tests {
         };
         let lidar = Lidar::new(c.clone()).unwrap_or_else(|e| unreachable!("{e}"));
         let pose = RigidPose::from_xyz_rpy([0.0, 0.0, 3.0], [0.0; 3]);
-        let env = LidarEnv {
-            fog_extinction_per_m: 3.0 / 600.0,
-            wave_height_m: 1.5,
-            wind_speed_m_s: 9.0,
-            ..LidarEnv::default()
-        };
+        let env = LidarEnv { fog_extinction_per_m: 3.0 / 600.0, wave_height_m: 1.5, wind_speed_m_s: 9.0 };
         let scan = lidar.scan(&s, &pose, &env, 4).unwrap_or_else(|e| unreachable!("{e}"));
         let dirs: Vec<[f32; 3]> =
             lidar.pattern().iter().map(|d| pose.transform_vector(Vec3::from_array(*d)).to_array()).collect();

@@ -137,8 +137,6 @@ fn lidar_refuses_bad_environment_and_poses() {
     let cases = [
         ("fog NaN", LidarEnv { fog_extinction_per_m: f32::NAN, ..LidarEnv::default() }, "fog_extinction_per_m"),
         ("fog < 0", LidarEnv { fog_extinction_per_m: -0.5, ..LidarEnv::default() }, "fog_extinction_per_m"),
-        ("rain inf", LidarEnv { rain_mm_per_h: f32::INFINITY, ..LidarEnv::default() }, "rain_mm_per_h"),
-        ("rain < 0", LidarEnv { rain_mm_per_h: -1.0, ..LidarEnv::default() }, "rain_mm_per_h"),
         ("waves NaN", LidarEnv { wave_height_m: f32::NAN, ..LidarEnv::default() }, "wave_height_m"),
         ("wind < 0", LidarEnv { wind_speed_m_s: -3.0, ..LidarEnv::default() }, "wind_speed_m_s"),
     ];
