@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import yaml
 from mmusv.acquire import run
-from mmusv.preview import _TITLE_H, BOX_COLOUR, compose_preview
+from mmusv.preview import _RING, _TITLE_H, BOX_COLOUR, _font, _rings, compose_preview
 from mmusv.recording import frame_messages, read_info, topics
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -125,6 +125,22 @@ def test_ppi_ring_scale_from_the_recording(recording: Path) -> None:
     assert a.ppi_metres_per_pixel == pytest.approx(1000 / 32)  # range_m / (ppi_size_px // 2)
     # the panel spans the PPI image: 64 px × m/px metres across
     assert ppi.scale * 64 * a.ppi_metres_per_pixel == pytest.approx(ppi.box[2] - ppi.box[0])
+
+
+def test_ring_labels_stand_on_a_black_backing_over_returns() -> None:
+    """Over a PPI full of returns, a ring label's box holds the label's colour, black and the anti-aliased shades
+    between them, none of the returns' green (a return behind the "1" of "1000 m" made it read "4000 m")."""
+    from PIL import Image, ImageDraw
+
+    green = (40, 220, 40)
+    pil = Image.new("RGB", (200, 200), green)
+    draw = ImageDraw.Draw(pil)
+    _rings(draw, centre=(100.0, 100.0), px_per_m=0.05, max_m=2000.0)
+    at = (100 + 1000 * 0.05 * 0.7071 + 2, 100 - 1000 * 0.05 * 0.7071 - 12)
+    x0, y0, x1, y1 = (round(v) for v in draw.textbbox(at, "1000 m", font=_font(11)))
+    patch = np.asarray(pil)[y0:y1, x0:x1].reshape(-1, 3).astype(int)
+    assert patch.size and not (patch == green).all(axis=1).any()
+    assert (patch == _RING).all(axis=1).any()  # the label itself is drawn
 
 
 def test_unknown_agent_is_a_clear_error(recording: Path) -> None:

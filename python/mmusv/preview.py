@@ -82,7 +82,8 @@ def _nice_step(span_m: float) -> float:
 
 
 def _rings(draw: ImageDraw.ImageDraw, *, centre: tuple[float, float], px_per_m: float, max_m: float) -> None:
-    """Range rings every 1-2-5 step up to ``max_m``, each labelled with its range in metres."""
+    """Range rings every 1-2-5 step up to ``max_m``, each labelled with its range in metres on a black backing (a
+    return under a label made a "1000 m" read "4000 m")."""
     step = _nice_step(max_m)
     font = _font(11)
     r_m = step
@@ -91,7 +92,10 @@ def _rings(draw: ImageDraw.ImageDraw, *, centre: tuple[float, float], px_per_m: 
         cx, cy = centre
         draw.ellipse((cx - r, cy - r, cx + r, cy + r), outline=_RING)
         label = f"{r_m:g} m"
-        draw.text((cx + r * 0.7071 + 2, cy - r * 0.7071 - 12), label, fill=_RING, font=font)
+        at = (cx + r * 0.7071 + 2, cy - r * 0.7071 - 12)
+        x0, y0, x1, y1 = draw.textbbox(at, label, font=font)
+        draw.rectangle((x0 - 1, y0 - 1, x1 + 1, y1 + 1), fill=(0, 0, 0))
+        draw.text(at, label, fill=_RING, font=font)
         r_m += step
 
 
