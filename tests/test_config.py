@@ -120,7 +120,7 @@ def test_bundled_scenarios_validate_and_hash_is_stable() -> None:
         ({"type": "island", "params": {"n_moored": 3}}, "map.params.n_moored", "Extra inputs"),
         ({"type": "port", "params": {"entrance_width_m": 5000}}, "map.params.entrance_width_m", "in [60, 860]"),
         ({"type": "open_sea", "params": {"islet_radius_m": [50, 20]}}, "map.params.islet_radius_m", "a <= b"),
-        ({"type": "island", "params": {"extent_m": 20000}}, "map.params.grid_m", "extent_m / 2000 = 10"),
+        ({"type": "island", "params": {"extent_m": 20000, "grid_m": 5}}, "map.params.grid_m", "extent_m / 2000 = 10"),
         ({"type": "port", "params": {"vegetation": "yes"}}, "map.params.vegetation", "boolean"),
     ],
 )

@@ -477,7 +477,6 @@ def test_bad_parameters_are_rejected_naming_the_field(kind: str, params: dict[st
     ("kind", "params", "field", "said"),
     [
         ("port", {"draft_margin_m": 12.0}, "basin_depth_m", "lower bound is draft_margin_m + 3"),
-        ("island", {"extent_m": 200.0}, "island_radius_m", "upper bound is extent_m / 2"),
         ("open_sea", {"extent_m": 200.0, "islet_radius_m": (30.0, 60.0)}, "islet_radius_m", "extent_m / 4"),
     ],
 )
@@ -497,6 +496,34 @@ def test_unknown_kind_lists_the_kinds_and_bad_seed_is_rejected() -> None:
     with pytest.raises(MapConfigError) as err:
         generate_map("island", seed=-3)
     assert err.value.field == "seed"
+
+
+def test_a_map_of_any_allowed_extent_builds_with_the_other_knobs_at_their_defaults() -> None:
+    """Only ``extent_m`` set, within its range: an island map of 200 m was refused for the default island radii
+    (``island_radius_m`` (60, 280): "the upper bound is extent_m / 2"), one of 600 m for the default five islands
+    that did not fit, and any map past 10 km for the default ``grid_m`` (5 m: "must be >= extent_m / 2000"). Now a
+    default outside the range the extent allows is cut to it, ``n_islands`` left at its default places as many as
+    fit up to 5 (and the built map's parameters say how many), and the defaults the extent allows are the ones they
+    were, so every map that built before builds the same."""
+    built = [generate_map("island", seed=seed, extent_m=extent) for extent in (200.0, 300.0, 600.0) for seed in (0, 1)]
+    for w in built:
+        p = w.params
+        assert isinstance(p, IslandParams)
+        lo, hi = p.island_radius_m or (0.0, 0.0)
+        assert 15.0 <= lo <= hi <= p.extent_m / 2 and p.min_gap_m is not None and p.min_gap_m <= p.extent_m / 2
+        assert 1 <= p.n_islands <= 5 and p.model_dump(exclude_unset=True) == {"extent_m": p.extent_m}
+    assert min(w.params.n_islands for w in built) < 5  # some small maps hold fewer
+    assert generate_map("open_sea", seed=0, extent_m=200.0).params.islet_radius_m == (25.0, 50.0)
+    for kind in ("island", "open_sea", "port"):
+        assert make_params(kind, extent_m=20000.0).grid_m == 10.0
+    island, sea, port = make_params("island"), make_params("open_sea"), make_params("port")
+    assert isinstance(island, IslandParams) and isinstance(sea, OpenSeaParams)
+    assert (island.island_radius_m, island.min_gap_m, island.n_islands, island.grid_m) == ((60.0, 280.0), 120.0, 5, 5)
+    assert sea.islet_radius_m == (25.0, 70.0) and sea.grid_m == port.grid_m == 5.0
+    # A number of islands the scenario sets is built exactly, or refused.
+    with pytest.raises(MapConfigError) as err:
+        generate_map("island", seed=1, extent_m=200.0, n_islands=5)
+    assert err.value.field == "n_islands" and "of the 5 islands of island_radius_m [60, 100]" in str(err.value)
 
 
 def test_islands_that_cannot_fit_are_reported() -> None:

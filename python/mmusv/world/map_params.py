@@ -30,6 +30,7 @@ __all__ = [
     "OpenSeaParams",
     "PortParams",
     "make_params",
+    "resolved",
 ]
 
 MAP_KINDS = ("island", "open_sea", "port")
@@ -100,6 +101,24 @@ def _up_to_extent(value: _Bounded, info: ValidationInfo, *, lo: float, divisor: 
     return _within(value, lo, hi, bounds=bounds)
 
 
+_T = TypeVar("_T")
+
+
+def resolved(value: _T | None) -> _T:
+    """A knob left at ``None`` that its parameter model has resolved from ``extent_m`` and the other knobs (never
+    ``None`` once the model is built: :class:`IslandParams`, :class:`OpenSeaParams`, :class:`PortParams`)."""
+    if value is None:
+        raise ValueError("map parameters were not resolved; build them with make_params(kind, ...)")
+    return value
+
+
+def _clamped(default: tuple[float, float], *, lo: float, hi: float) -> tuple[float, float]:
+    """A default range of sizes ``default`` (metres) with each end kept within ``[lo, hi]`` (the bounds the map's
+    extent allows): the default where it is allowed, so that a map it built before is built the same."""
+    a, b = (float(min(max(x, lo), hi)) for x in default)
+    return a, b
+
+
 class _CommonParams(BaseModel):
     """Parameters shared by every map kind (metres)."""
 
@@ -107,8 +126,9 @@ class _CommonParams(BaseModel):
 
     extent_m: float = Field(default=2000.0, ge=200.0, le=20000.0)
     """Side of the square map."""
-    grid_m: float = Field(default=5.0, ge=1.0, le=20.0)
-    """Terrain heightfield spacing (effective value: ``extent_m / round(extent_m / grid_m)``)."""
+    grid_m: float | None = Field(default=None, ge=1.0, le=20.0)
+    """Terrain heightfield spacing (effective value: ``extent_m / round(extent_m / grid_m)``) [5, or ``extent_m /
+    2000`` past 10 km, the finest the heightfield's 2000 × 2000 cells allow]."""
     prior_resolution_m: float = Field(default=5.0, ge=0.5, le=50.0)
     """Prior raster cell size (effective value: ``extent_m / round(extent_m / prior_resolution_m)``)."""
     draft_margin_m: float = Field(default=2.0, ge=0.0, le=20.0)
@@ -127,8 +147,12 @@ class _CommonParams(BaseModel):
 
     @field_validator("grid_m")
     @classmethod
-    def _grid(cls, v: float, info: ValidationInfo) -> float:
-        if _known(info, "extent_m") and (info.data["extent_m"] / v) ** 2 > 4.0e6:
+    def _grid(cls, v: float | None, info: ValidationInfo) -> float | None:
+        if not _known(info, "extent_m"):
+            return v
+        if v is None:
+            return max(5.0, float(info.data["extent_m"]) / 2000.0)
+        if (info.data["extent_m"] / v) ** 2 > 4.0e6:
             raise ValueError(f"must be >= extent_m / 2000 = {info.data['extent_m'] / 2000.0:g}")
         return v
 
@@ -150,17 +174,21 @@ class IslandParams(_CommonParams):
 
     n_buoys: int = Field(default=2, ge=0, le=500)
     n_islands: int = Field(default=5, ge=0, le=50)
-    island_radius_m: tuple[float, float] = (60.0, 280.0)
-    """Range of island radii ``R`` (15 m to ``extent_m / 2``): a quarter of the islands are one dome of radius ``R``,
-    the rest a main dome of ``0.72 R`` with one to three lobes reaching out to ``R``, so an island's farthest coast
-    is about ``R`` from its centre and its mean coast radius ``0.75 R`` to ``R`` (before ``coast_roughness``). Where
-    the islands do not fit, ``R`` is cut by 15 % at a time (down to 15 m) before the map is refused."""
+    """Islands on the map. A number the scenario sets is built exactly, and refused where they do not fit (naming
+    how many do); left at its default, as many as fit up to 5, and ``MapWorld.params.n_islands`` says how many."""
+    island_radius_m: tuple[float, float] | None = None
+    """Range of island radii ``R`` (15 m to ``extent_m / 2``) [(60, 280), cut to ``extent_m / 2`` on a map under
+    560 m]: a quarter of the islands are one dome of radius ``R``, the rest a main
+    dome of ``0.72 R`` with one to three lobes reaching out to ``R``, so an island's farthest coast is about ``R``
+    from its centre and its mean coast radius ``0.75 R`` to ``R`` (before ``coast_roughness``). Where the islands do
+    not fit, ``R`` is cut by 15 % at a time (down to 15 m) before the map is refused."""
     island_height_m: tuple[float, float] = (15.0, 80.0)
     """Range of the islands' dome heights (capped at 0.35 x radius); the terrain's relief adds up to 35 % of it up or
     down, so a summit may stand above the range's top: ``[40, 40]`` gives summits of 34-47 m, the defaults up to
     86 m."""
-    min_gap_m: float = Field(default=120.0, ge=0.0)
-    """Minimum open-water gap between two islands' coasts (at most ``extent_m / 2``)."""
+    min_gap_m: float | None = Field(default=None, ge=0.0)
+    """Minimum open-water gap between two islands' coasts (at most ``extent_m / 2``) [120, cut to ``extent_m / 2``
+    on a map under 240 m]."""
     coast_roughness: float = Field(default=0.25, ge=0.0, le=0.5)
     """Relative coastline irregularity (0 = round)."""
     vegetation: StrictBool = True
@@ -168,8 +196,10 @@ class IslandParams(_CommonParams):
 
     @field_validator("island_radius_m")
     @classmethod
-    def _radius(cls, v: tuple[float, float], info: ValidationInfo) -> tuple[float, float]:
-        return _up_to_extent(v, info, lo=15.0, divisor=2)
+    def _radius(cls, v: tuple[float, float] | None, info: ValidationInfo) -> tuple[float, float] | None:
+        if v is None and _known(info, "extent_m"):
+            v = _clamped((60.0, 280.0), lo=15.0, hi=info.data["extent_m"] / 2.0)
+        return v if v is None else _up_to_extent(v, info, lo=15.0, divisor=2)
 
     @field_validator("island_height_m")
     @classmethod
@@ -178,8 +208,10 @@ class IslandParams(_CommonParams):
 
     @field_validator("min_gap_m")
     @classmethod
-    def _gap(cls, v: float, info: ValidationInfo) -> float:
-        return _up_to_extent(v, info, lo=0.0, divisor=2)
+    def _gap(cls, v: float | None, info: ValidationInfo) -> float | None:
+        if v is None and _known(info, "extent_m"):
+            v = min(120.0, info.data["extent_m"] / 2.0)
+        return v if v is None else _up_to_extent(v, info, lo=0.0, divisor=2)
 
 
 class OpenSeaParams(_CommonParams):
@@ -188,15 +220,17 @@ class OpenSeaParams(_CommonParams):
     extent_m: float = Field(default=4000.0, ge=200.0, le=20000.0)
     n_buoys: int = Field(default=4, ge=0, le=500)
     islet_probability: float = Field(default=0.5, ge=0.0, le=1.0)
-    islet_radius_m: tuple[float, float] = (25.0, 70.0)
-    """Range of islet radii (10 m to ``extent_m / 4``)."""
+    islet_radius_m: tuple[float, float] | None = None
+    """Range of islet radii (10 m to ``extent_m / 4``) [(25, 70), cut to ``extent_m / 4`` on a map under 280 m]."""
     islet_height_m: tuple[float, float] = (5.0, 20.0)
     vegetation: StrictBool = True
 
     @field_validator("islet_radius_m")
     @classmethod
-    def _radius(cls, v: tuple[float, float], info: ValidationInfo) -> tuple[float, float]:
-        return _up_to_extent(v, info, lo=10.0, divisor=4)
+    def _radius(cls, v: tuple[float, float] | None, info: ValidationInfo) -> tuple[float, float] | None:
+        if v is None and _known(info, "extent_m"):
+            v = _clamped((25.0, 70.0), lo=10.0, hi=info.data["extent_m"] / 4.0)
+        return v if v is None else _up_to_extent(v, info, lo=10.0, divisor=4)
 
     @field_validator("islet_height_m")
     @classmethod

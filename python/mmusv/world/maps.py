@@ -16,7 +16,7 @@ kind, seed and parameters give bitwise-identical arrays.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 import shapely
@@ -33,6 +33,7 @@ from mmusv.world.map_params import (
     OpenSeaParams,
     PortParams,
     make_params,
+    resolved,
 )
 from mmusv.world.port import buoy_mesh, plan_port, port_structures, port_terrain
 from mmusv.world.primitives import TriMesh, merge, transformed
@@ -255,9 +256,15 @@ def _check_seed(seed: object) -> int:
     return int(seed)
 
 
-def _place_islands(p: IslandParams, rng: np.random.Generator) -> list[IslandSpec]:
+_P = TypeVar("_P", IslandParams, PortParams)
+
+
+def _place_islands(p: IslandParams, rng: np.random.Generator) -> tuple[list[IslandSpec], int]:
+    """The domes of the map's islands and how many islands they make: ``n_islands``, or, left at its default, as
+    many as fit up to it (a small map); an ``n_islands`` the parameters set that does not fit is refused."""
     half = p.extent_m / 2.0
-    radii = np.sort(rng.uniform(*p.island_radius_m, size=p.n_islands))[::-1]
+    (lo, hi), gap = resolved(p.island_radius_m), resolved(p.min_gap_m)
+    radii = np.sort(rng.uniform(lo, hi, size=p.n_islands))[::-1]
     placed: list[tuple[np.ndarray, float]] = []
     specs: list[IslandSpec] = []
     for r0 in radii:
@@ -272,16 +279,17 @@ def _place_islands(p: IslandParams, rng: np.random.Generator) -> list[IslandSpec
             if lim <= 0.0:
                 continue
             c = rng.uniform(-lim, lim, size=2)
-            if all(np.hypot(*(c - c2)) >= (r + r2) * grow + p.min_gap_m for c2, r2 in placed):
+            if all(np.hypot(*(c - c2)) >= (r + r2) * grow + gap for c2, r2 in placed):
                 break
         else:
-            lo, hi = p.island_radius_m
+            if "n_islands" not in p.model_fields_set:
+                continue  # the default: as many as fit (a smaller one may yet)
             raise MapConfigError(
                 "n_islands",
                 p.n_islands,
                 f"fewer or smaller islands: with this map seed only {len(placed)} of the {p.n_islands} islands of "
                 f"island_radius_m [{lo:g}, {hi:g}] fit in extent_m = {p.extent_m:g} at least min_gap_m = "
-                f"{p.min_gap_m:g} apart (lower n_islands or island_radius_m, lower min_gap_m, or raise extent_m)",
+                f"{gap:g} apart (lower n_islands or island_radius_m, lower min_gap_m, or raise extent_m)",
             )
         placed.append((c, r))
         peak = min(float(rng.uniform(*p.island_height_m)), 0.35 * r)
@@ -302,7 +310,7 @@ def _place_islands(p: IslandParams, rng: np.random.Generator) -> list[IslandSpec
                     harmonics=_harmonics(rng, p.coast_roughness),
                 )
             )
-    return specs
+    return specs, len(placed)
 
 
 def island_fit_problem(seed: int, params: IslandParams) -> str | None:
@@ -336,8 +344,10 @@ def generate_island(*, seed: int, params: IslandParams | None = None) -> MapWorl
     seed = _check_seed(seed)
     p: IslandParams = _check_params(params, IslandParams, "island")
     rng = np.random.default_rng(seed)
-    spacing, xs = _grid(p.extent_m, p.grid_m)
-    islands = _place_islands(p, rng)
+    spacing, xs = _grid(p.extent_m, resolved(p.grid_m))
+    islands, n_islands = _place_islands(p, rng)
+    if n_islands < p.n_islands:  # left at its default on a map too small for it: say how many were built
+        p = _unset_copy(p, n_islands=n_islands)
     hf = _island_terrain(rng, xs, spacing, islands, p.coast_roughness, p.extent_m)
     classify = _vegetation(rng, p.extent_m, p.vegetation, 4.0)
     buoys = _free_buoys(
@@ -352,11 +362,11 @@ def generate_open_sea(*, seed: int, params: OpenSeaParams | None = None) -> MapW
     seed = _check_seed(seed)
     p: OpenSeaParams = _check_params(params, OpenSeaParams, "open_sea")
     rng = np.random.default_rng(seed)
-    spacing, xs = _grid(p.extent_m, p.grid_m)
+    spacing, xs = _grid(p.extent_m, resolved(p.grid_m))
     half = p.extent_m / 2.0
     islands: list[IslandSpec] = []
     if rng.uniform() < p.islet_probability:
-        r = float(rng.uniform(*p.islet_radius_m))
+        r = float(rng.uniform(*resolved(p.islet_radius_m)))
         dist, ang = rng.uniform(0.55, 0.8) * half, rng.uniform(0.0, 2.0 * np.pi)
         dist = min(float(dist), half - 2.0 * r - 60.0)
         peak = min(float(rng.uniform(*p.islet_height_m)), 0.4 * r)
@@ -395,7 +405,7 @@ def generate_port(*, seed: int, params: PortParams | None = None) -> MapWorld:
     seed = _check_seed(seed)
     p: PortParams = _check_params(params, PortParams, "port")
     rng = np.random.default_rng(seed)
-    spacing, xs = _grid(p.extent_m, p.grid_m)
+    spacing, xs = _grid(p.extent_m, resolved(p.grid_m))
     r0, r1, dyaw = _COAST_ROT[p.coast_side]
     m = np.array([r0, r1], dtype=np.float64)
     rot3 = np.eye(3)
@@ -459,7 +469,7 @@ def generate_port(*, seed: int, params: PortParams | None = None) -> MapWorld:
     )
 
 
-def _unset_copy(p: PortParams, **values: Any) -> PortParams:
+def _unset_copy(p: _P, **values: Any) -> _P:
     """``p`` with ``values`` replaced and the same fields counted as set (a dump with ``exclude_unset`` still gives
     back only what the user set)."""
     out = p.model_copy(update=values)

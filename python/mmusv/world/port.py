@@ -10,13 +10,14 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, TypeVar
+from typing import TYPE_CHECKING
 
 import numpy as np
 import shapely
 from shapely.geometry import Polygon
 
 from mmusv.classes import SemanticClass
+from mmusv.world.map_params import resolved
 from mmusv.world.primitives import TriMesh, box, cylinder, merge, transformed
 
 if TYPE_CHECKING:
@@ -82,16 +83,6 @@ class Berth:
         return Polygon(pts @ np.array([[c, s], [-s, c]]) + (x, y))
 
 
-T = TypeVar("T")
-
-
-def _set(value: T | None) -> T:
-    """A layout knob that :class:`~mmusv.world.maps.PortParams` has resolved (never None after validation)."""
-    if value is None:
-        raise ValueError("port parameters were not resolved; build them with PortParams(...)")
-    return value
-
-
 def _smoothstep(e0: float | np.ndarray, e1: float | np.ndarray, x: np.ndarray) -> np.ndarray:
     t = np.clip((x - e0) / (e1 - e0), 0.0, 1.0)
     out: np.ndarray = t * t * (3.0 - 2.0 * t)
@@ -101,9 +92,9 @@ def _smoothstep(e0: float | np.ndarray, e1: float | np.ndarray, x: np.ndarray) -
 def plan_port(p: PortParams, *, grid: float, rng: np.random.Generator) -> PortPlan:
     """Draws the layout (entrance position, pier lengths) for validated parameters ``p``."""
     half = p.extent_m / 2.0
-    q = _set(p.coast_offset_m)
-    hw, hd, ew = _set(p.harbour_width_m), _set(p.harbour_depth_m), _set(p.entrance_width_m)
-    n_piers = _set(p.n_piers)
+    q = resolved(p.coast_offset_m)
+    hw, hd, ew = resolved(p.harbour_width_m), resolved(p.harbour_depth_m), resolved(p.entrance_width_m)
+    n_piers = resolved(p.n_piers)
     span = hw / 2.0 - ew / 2.0 - 80.0
     entrance_x = float(rng.uniform(-0.5, 0.5) * max(span, 0.0))
     terminal_x1 = -hw / 2.0 + (0.6 if n_piers > 0 else 1.0) * hw
@@ -116,7 +107,7 @@ def plan_port(p: PortParams, *, grid: float, rng: np.random.Generator) -> PortPl
         a, b = terminal_x1 + 30.0, hw / 2.0 - 30.0
         pitch = (b - a) / n_piers
         for k in range(n_piers):
-            length = float(rng.uniform(*_set(p.pier_length_m)))
+            length = float(rng.uniform(*resolved(p.pier_length_m)))
             piers.append((a + (k + 0.5) * pitch, min(length, hd - 100.0)))
     return PortPlan(
         half=half,
@@ -316,7 +307,7 @@ def port_structures(p: PortParams, plan: PortPlan, *, ground: Ground, rng: np.ra
         )
     # Gantry cranes along the terminal quay.
     t0, t1 = -hw / 2.0 + 40.0, plan.terminal_x1 - 20.0
-    n_cranes = _set(p.n_cranes)
+    n_cranes = resolved(p.n_cranes)
     if n_cranes:
         pitch = (t1 - t0) / n_cranes
         for k in range(n_cranes):
