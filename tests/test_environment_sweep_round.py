@@ -8,8 +8,8 @@ What is checked here, beside the field-level checks of ``tests/world/test_enviro
 * the labels are geometry (``docs/recording.md``: depth, semantic and instance images, 3D/BEV/2D boxes, the world
   state): the same seed under a clear noon and a foggy night, rainy dusk or overcast southern morning gives the same
   bytes, but for the LiDAR's own ``lidar_points`` count, which the weather thins;
-* each sensor reads only what ``mmusv.sensors.env`` says it uses: the LiDAR fog, rain and waves; the radar rain and
-  waves; the sun (time of day, latitude, day of year) reaches the cameras alone;
+* each sensor reads only what ``mmusv.sensors.env`` says it uses: the LiDAR the visibility (fog, rain's drops) and
+  the waves; the radar rain and waves; the sun (time of day, latitude, day of year) reaches the cameras alone;
 * the pictures through the whole pipeline (render, exposure, tone curve, PNG): no NaN in the depth, +inf exactly
   on the sky, a day view that is not black, a night view that stays dark, a fog whose contrast falls with distance
   at its Koschmieder rate and is under the WMO's 0.05 beyond the visibility, and an automatic exposure that meters
@@ -47,7 +47,7 @@ MAPS: dict[str, tuple[dict[str, Any], list[list[float]], list[list[float]]]] = {
 CLEAR_NOON = {"time_of_day": "12:00", "weather": "clear", "wave": "W1"}
 OTHER_SKIES = {
     "fog_night": {"time_of_day": "00:00", "weather": "fog", "visibility_m": 120, "wave": "W1"},
-    "rain_dusk": {"time_of_day": "20:30", "weather": "rain", "rain_mm_per_h": 25, "visibility_m": 1500, "wave": "W1"},
+    "rain_dusk": {"time_of_day": "20:30", "weather": "rain", "rain_mm_per_h": 25, "visibility_m": 1000, "wave": "W1"},
     "overcast_south": {
         "time_of_day": "09:40",
         "weather": "overcast",

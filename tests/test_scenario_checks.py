@@ -1,6 +1,7 @@
 """mmusv.scenario_checks.check_sensors: a scenario that records no sensor at all is said so, once, as a warning (the
 malformed-input review's: ``preset: lidar_only`` with ``lidar: null``, or no vessel with ``role: usv``, ran without a
-word and recorded the world state only)."""
+word and recorded the world state only). check_rain_visibility: a visibility given clearer than its rain's drops
+alone allow is said so (it was kept without a word, and the LiDAR takes the rain through the visibility alone)."""
 
 from __future__ import annotations
 
@@ -13,7 +14,7 @@ import pytest
 import yaml
 from mmusv.cli import main
 from mmusv.config import load_scenario
-from mmusv.scenario_checks import MmusvWarning, check_sensors
+from mmusv.scenario_checks import MmusvWarning, check_rain_visibility, check_sensors
 
 BASE: dict[str, Any] = {
     "name": "t",
@@ -143,3 +144,55 @@ def test_a_vessel_whose_keel_reaches_the_seabed_is_warned_about(tmp_path: Path) 
     deeper = copy.deepcopy(scenario("port"))
     deeper["map"]["params"] = {"basin_depth_m": 16.0}
     assert check_under_keel(deeper) == []
+
+
+def _rainy(**environment: Any) -> dict[str, Any]:
+    doc = copy.deepcopy(BASE)
+    doc["environment"] = {"time_of_day": "12:00", **environment}
+    return doc
+
+
+@pytest.mark.parametrize(
+    ("environment", "limit_m"),
+    [
+        ({"weather": "rain", "rain_mm_per_h": 25, "visibility_m": 1500}, 1083),
+        ({"weather": "rain", "visibility_m": 5000}, 3435),  # the rain weather's default 4 mm/h
+        ({"weather": "fog", "rain_mm_per_h": 50, "visibility_m": 800}, 700),
+        ({"weather": "rain", "rain_mm_per_h": 25, "visibility_m": 1000}, None),  # within the drops' limit
+        ({"weather": "rain", "rain_mm_per_h": 50}, None),  # left out: the rain's own
+        ({"weather": "rain", "rain_mm_per_h": 0, "visibility_m": 20000}, None),  # a rain sky without its drops
+        ({"weather": "clear", "visibility_m": 50000}, None),
+    ],
+)
+def test_a_visibility_clearer_than_its_rain_allows_is_warned_about(
+    environment: dict[str, Any], limit_m: int | None
+) -> None:
+    """The limit is the drops' own, ``3 / σ`` with σ = π N₀ / Λ³ of Marshall and Palmer's drops (``mmusv.world.rain``,
+    checked there against the drop-size integral): 0.365 R^0.63 per km, 3.4 km at 4 mm/h, 1.1 km at 25, 0.7 km at 50."""
+    scenario = load_scenario(_rainy(**environment))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        found = check_rain_visibility(scenario, source="s.yaml")
+    assert [str(w.message) for w in caught if w.category is MmusvWarning] == found
+    if limit_m is None:
+        assert found == []
+    else:
+        given = environment["visibility_m"]
+        assert len(found) == 1 and found[0].startswith(f"s.yaml: environment.visibility_m = {given} is clearer"), found
+        assert f"limit the visibility to {limit_m} m" in found[0], found
+
+
+def test_the_run_and_the_editor_say_the_rain_s_visibility(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from mmusv.editor.evaluate import evaluate
+
+    doc = _rainy(weather="rain", rain_mm_per_h=25, visibility_m=1500)
+    doc["acquisition"]["frames"] = 1
+    src = tmp_path / "t.yaml"
+    src.write_text(yaml.safe_dump(doc), encoding="utf-8")
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", MmusvWarning)  # printed, as on the command line (the tests make them errors)
+        assert main(["run", str(src), "-o", str(tmp_path / "out")]) == 0
+    err = capsys.readouterr().err
+    assert f"mmusv: warning: {src}: environment.visibility_m = 1500 is clearer than rain of 25 mm/h" in err, err
+    (p,) = [p for p in evaluate(doc)["problems"] if p["check"] == "rain"]
+    assert p["severity"] == "warning" and p["field"] == "environment.visibility_m", p

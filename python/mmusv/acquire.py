@@ -53,6 +53,7 @@ from mmusv.run_folder import (
 from mmusv.scenario_checks import (
     check_lidar_water,
     check_mounts,
+    check_rain_visibility,
     check_routes,
     check_sensors,
     check_top_view_land,
@@ -257,7 +258,8 @@ def run(
         sim = Simulation(scenario)
     except MmusvError as exc:
         raise located(exc, source) from None
-    check_sensors(scenario, source=source)  # not a check of the map: said with or without checks
+    check_sensors(scenario, source=source)  # not checks of the map: said with or without checks
+    check_rain_visibility(scenario, source=source)
     if checks:
         check_mounts(scenario, source=source)
         check_lidar_water(scenario, source=source)

@@ -17,6 +17,7 @@ probabilities 0, which switch the water returns off.
 ``under_keel`` (:func:`keel_findings`, a warning of :func:`check_routes` and a finding of :func:`map_findings`): a
 vessel whose draft reaches the seabed under it at some frame (``in_water`` takes every hull's water alike, 2 m deep:
 a 300 m ship could sail a port's shallows with its keel in the floor).
+:func:`check_rain_visibility` warns about a visibility given clearer than its rain's drops alone allow.
 :func:`check_sensors` warns about a scenario that records no sensor at all: no vessel with ``role: usv``, or USVs
 whose rigs switch every sensor off (``preset: lidar_only`` with ``lidar: null``); such a run records the world state
 and the boxes only, which may be meant (ground-truth trajectories), so it is a warning.
@@ -57,6 +58,7 @@ __all__ = [
     "TopViewLand",
     "check_lidar_water",
     "check_mounts",
+    "check_rain_visibility",
     "check_routes",
     "check_sensors",
     "check_top_view_land",
@@ -320,6 +322,33 @@ def check_mounts(scenario: Scenario, *, source: str) -> list[str]:
                 found.append(
                     f"{source}: {where} (vessel {v.id}) is {dist:.0f} m from the {asset.name} hull; xyz is in metres"
                 )
+    for w in found:
+        warnings.warn(w, MmusvWarning, stacklevel=2)
+    return found
+
+
+def check_rain_visibility(scenario: Scenario, *, source: str) -> list[str]:
+    """Warns (and returns the warning) when ``environment.visibility_m`` is given clearer than the drops of its rain
+    alone allow: ``3 / σ_rain`` for Marshall–Palmer drops (:func:`mmusv.world.rain.rain_extinction_per_m`: 3.4 km
+    at 4 mm/h, 1.1 km at 25, 0.7 km at 50). The visibility given is the air's whole extinction for the cameras and
+    the LiDAR, the rain's drops included, and is kept; such a one lets them see through the rain as through clearer
+    air (the LiDAR takes the rain through the visibility alone). A warning, not an error: real drop sizes stray from
+    Marshall and Palmer's, and a test may hold the air fixed on purpose."""
+    from mmusv.world.rain import rain_extinction_per_m
+
+    env = scenario.environment
+    found: list[str] = []
+    if env.visibility_m is None:
+        return found
+    weather = env.resolve().weather
+    sigma = rain_extinction_per_m(weather.rain_mm_per_h)
+    if sigma > 0.0 and env.visibility_m > 3.0 / sigma:
+        found.append(
+            f"{source}: environment.visibility_m = {env.visibility_m:g} is clearer than rain of "
+            f"{weather.rain_mm_per_h:g} mm/h allows: its drops alone (Marshall-Palmer) limit the visibility to "
+            f"{3.0 / sigma:.0f} m, and the cameras' air and the LiDAR take the visibility given, drops included; "
+            "lower visibility_m, or leave it out (the weather's air with the rain's drops in it)"
+        )
     for w in found:
         warnings.warn(w, MmusvWarning, stacklevel=2)
     return found

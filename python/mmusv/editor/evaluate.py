@@ -45,7 +45,14 @@ from mmusv.errors import ConfigError, MmusvError
 from mmusv.generate.mapctx import map_context
 from mmusv.generate.samples import FEWER_TIMES, MAX_CHECK_SAMPLES, budget_problem, sample_counts
 from mmusv.motion import build_fleet
-from mmusv.scenario_checks import check_mounts, check_sensors, map_check_spec, map_findings, top_view_land
+from mmusv.scenario_checks import (
+    check_mounts,
+    check_rain_visibility,
+    check_sensors,
+    map_check_spec,
+    map_findings,
+    top_view_land,
+)
 from mmusv.sensors.config import RigConfig
 from mmusv.text import counted
 from mmusv.world.vessels import get_asset
@@ -305,7 +312,9 @@ def evaluate(
         warnings.simplefilter("ignore")
         mounts = check_mounts(scenario, source="scenario")
         sensors = check_sensors(scenario, source="scenario")
-    for check, msg in [("mounts", m) for m in mounts] + [("sensors", m) for m in sensors]:
+        rain = check_rain_visibility(scenario, source="scenario")
+    said = [("mounts", m) for m in mounts] + [("sensors", m) for m in sensors] + [("rain", m) for m in rain]
+    for check, msg in said:
         text = msg.removeprefix("scenario: ")
         field = text.split(" ", 1)[0].rstrip(",")
         out["problems"].append(
@@ -313,7 +322,7 @@ def evaluate(
                 "check": check,
                 "severity": "warning",
                 "message": text,
-                "field": field if field.startswith("rigs.") else "vessels",
+                "field": field if field.startswith(("rigs.", "environment.")) else "vessels",
                 "vessels": [],
                 "point": None,
                 "segments": {},
