@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import copy
 import warnings
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -26,6 +27,16 @@ BASE: dict[str, Any] = {
         {"id": "t1", "asset": "fishing_boat_12m", "speed_mps": 3, "route": [[-100, 20], [-400, 25]]},
     ],
 }
+
+
+def _warned(check: Callable[..., list[str]], doc: dict[str, Any]) -> list[str]:
+    """What ``check`` finds in the scenario ``doc`` (as from ``s.yaml``), checked to be what it warned, one
+    :class:`MmusvWarning` each."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        found = check(load_scenario(doc), source="s.yaml")
+    assert [str(w.message) for w in caught if w.category is MmusvWarning] == found
+    return found
 
 
 def _no_lidar() -> dict[str, Any]:
@@ -59,11 +70,7 @@ def _one_rig_empty() -> dict[str, Any]:  # two USVs, one of them with a sensor: 
     ids=["lidar-null", "no-usv", "one-of-two-empty", "lidar-only"],
 )
 def test_a_scenario_without_any_sensor_is_warned_about(make: Any, said: str | None) -> None:
-    scenario = load_scenario(make())
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        found = check_sensors(scenario, source="s.yaml")
-    assert [str(w.message) for w in caught if w.category is MmusvWarning] == found
+    found = _warned(check_sensors, make())
     if said is None:
         assert found == []
     else:
@@ -169,11 +176,7 @@ def test_a_visibility_clearer_than_its_rain_allows_is_warned_about(
 ) -> None:
     """The limit is the drops' own, ``3 / σ`` with σ = π N₀ / Λ³ of Marshall and Palmer's drops (``mmusv.world.rain``,
     checked there against the drop-size integral): 0.365 R^0.63 per km, 3.4 km at 4 mm/h, 1.1 km at 25, 0.7 km at 50."""
-    scenario = load_scenario(_rainy(**environment))
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        found = check_rain_visibility(scenario, source="s.yaml")
-    assert [str(w.message) for w in caught if w.category is MmusvWarning] == found
+    found = _warned(check_rain_visibility, _rainy(**environment))
     if limit_m is None:
         assert found == []
     else:
