@@ -33,9 +33,10 @@
 //!    `0.01 · R^0.6`, are the rain extinction that the LISA code (Kilic et al. 2021, arXiv:2107.07004,
 //!    `velatkilic/LISA`) attributes to Goodin et al. (2019), Electronics 8(1), 89, applied per metre. Not
 //!    modelled: the returns of the drops themselves near the sensor (LISA's), which a real LiDAR reports in
-//!    heavy rain. The return is lost with probability `1 − τ` — but for the physical water returns of step 3, whose speckle threshold already met the
-//!    attenuated mean `τ ⟨I⟩` (until 2026-12-01 they were lost with probability `1 − τ` as well, the fog counted
-//!    twice: at 600 m visibility a fifth fewer water returns 20 m out than the model gives, a third 40 m out);
+//!    heavy rain. The return is lost with probability `1 − τ` — but for the physical water returns of step 3,
+//!    whose speckle threshold already met the attenuated mean `τ ⟨I⟩` (until 2026-12-01 they were lost with
+//!    probability `1 − τ` as well, the fog counted twice: at 600 m visibility a fifth fewer water returns 20 m out
+//!    than the model gives, a third 40 m out);
 //! 5. random dropout with probability `dropout`;
 //! 6. range noise: `r' = r + N(0, range_noise_std)` (not below 0); a measured range `r' < range_min` or
 //!    `r' > range_max` gives no return (the sensor gates on what it measures: no point's range lies outside
