@@ -40,8 +40,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 }
 
 /// What every sensor sees of the environment at a frame: sun and sky (cameras), the fog extinction, the rain's
-/// drops included (cameras, LiDAR), the rain rate (the cameras' near drops, the radar) and waves (all three). Built once per scenario from the resolved environment; passed to every
-/// `Lidar.scan`, `Camera.render` and `Radar.sweep`.
+/// drops included (cameras, LiDAR), the rain rate (the cameras' near drops, the radar) and waves (all three). Built
+/// once per scenario from the resolved environment; passed to every `Lidar.scan`, `Camera.render` and `Radar.sweep`.
 #[pyclass(frozen, module = "mmusv._core")]
 pub struct SensorEnv {
     pub(crate) shade: ShadeEnv,
