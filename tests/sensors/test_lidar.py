@@ -5,9 +5,8 @@
   face hit belongs to the point's instance, rays without a point are misses there.
 * Pattern bookkeeping: ring / azimuth / ray_index / elevation of each point, explicit elevation tables.
 * Noise model: seeding, Gaussian range noise, dropout, water returns versus wave height, fog losses (rain's
-  through its visibility alone), and the
-  intensity formula ``ρ(class) · |cos θ| · τ / (1 + (r / 100 m)²)``, checked analytically on simple scenes
-  (a closed room whose every ray hits, a lone water plane).
+  through its visibility alone), and the intensity formula ``ρ(class) · |cos θ| · τ / (1 + (r / 100 m)²)``,
+  checked analytically on simple scenes (a closed room whose every ray hits, a lone water plane).
 """
 
 from __future__ import annotations
