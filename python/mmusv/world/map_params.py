@@ -179,10 +179,10 @@ class IslandParams(_CommonParams):
     island_radius_m: tuple[float, float] | None = None
     """Range of island radii ``R`` (15 m to ``extent_m / 2``) [(60, 280), cut to ``extent_m / 2`` on a map under
     560 m]: a quarter of the islands are one dome of radius ``R``, the rest a main dome of ``0.72 R`` with one to
-    three lobes reaching out to ``R``, so an island's farthest coast is about ``R`` from its centre and its mean
-    coast radius ``0.75 R`` to ``R`` (before ``coast_roughness``). Where the islands do not fit, ``R`` is cut by 15 %
-    at a time (down to 15 m) before the map is refused (or, with ``n_islands`` left at its default, the island left
-    out)."""
+    three lobes reaching out to ``R``, so an island's farthest coast is about ``R`` from its centre and its
+    mean coast radius ``0.75 R`` to ``R`` (before ``coast_roughness``). Where the islands do not fit, ``R`` is cut
+    by 15 % at a time (down to 15 m) before the map is refused (or, with ``n_islands`` left at its default, the
+    island left out)."""
     island_height_m: tuple[float, float] = (15.0, 80.0)
     """Range of the islands' dome heights (capped at 0.35 x radius); the terrain's relief adds up to 35 % of it up or
     down, so a summit may stand above the range's top: ``[40, 40]`` gives summits of 34-47 m, the defaults up to
