@@ -31,8 +31,9 @@
 //!   A drop's streak is its image's motion over the exposure, at its mid-exposure position (pinhole projection).
 //! * **The exposure time.** The camera of `tonemap.rs` (f/1.4, at most 1/30 s, then gain): at ISO 100 an exposure
 //!   scale `k = 1 / (1.2 · 2^EV100)` is `T = N² / 2^EV100 = 1.2 N² k`, held at 1/30 s when longer
-//!   ([`super::tonemap::exposure_time_s`]). By day the shutter is a fraction of a millisecond and the drops are frozen dots; at dusk
-//!   the streaks grow long and faint: the dependence on exposure time Garg & Nayar measured (2007, section 5).
+//!   ([`super::tonemap::exposure_time_s`]). By day the shutter is a fraction of a millisecond and the drops are
+//!   frozen dots; at dusk the streaks grow long and faint: the dependence on exposure time Garg & Nayar measured
+//!   (2007, section 5).
 //! * **Defocus.** The lens is focused at infinity, so a drop at depth `x` is blurred over a disc of `A f / x`
 //!   pixels, `A = f p / N` the aperture's diameter for a pixel pitch `p` ([`PIXEL_PITCH_M`]): its coverage is
 //!   spread over that disc where it is wider than the drop's image. A wide-angle camera's drops stay sharp (a 2 mm
@@ -267,12 +268,16 @@ pub fn coverage(
         let steps = (drop.streak_px().ceil() as usize + 1).min(MAX_STEPS);
         let spread = drop.spread_px();
         let side = (spread.ceil() as usize).clamp(1, 16);
-        let offsets: Vec<f32> = (0..side).map(|k| ((k as f32 + 0.5) / side as f32 - 0.5) * spread).collect();
+        // The sub-step offsets across (at most 16: an array, not an allocation per drop on this hot path).
+        let mut offsets = [0f32; 16];
+        for (k, o) in offsets.iter_mut().enumerate().take(side) {
+            *o = ((k as f32 + 0.5) / side as f32 - 0.5) * spread;
+        }
         let share = drop.area_px2() / (steps * side * side) as f32;
         for s in 0..steps {
             let t = if steps == 1 { 0.0 } else { s as f32 / (steps - 1) as f32 - 0.5 };
-            for &ou in &offsets {
-                for &ov in &offsets {
+            for &ou in &offsets[..side] {
+                for &ov in &offsets[..side] {
                     let (pu, pv) = (drop.at[0] + t * drop.streak[0] + ou, drop.at[1] + t * drop.streak[1] + ov);
                     splat(&mut cover, &mut light, (w, h), (pu, pv), share, l_d, drop.depth_m, depth);
                 }
