@@ -329,24 +329,27 @@ def check_mounts(scenario: Scenario, *, source: str) -> list[str]:
 
 def check_rain_visibility(scenario: Scenario, *, source: str) -> list[str]:
     """Warns (and returns the warning) when ``environment.visibility_m`` is given clearer than the drops of its rain
-    alone allow: ``3 / σ_rain`` for Marshall–Palmer drops (:func:`mmusv.world.rain.rain_extinction_per_m`: 3.4 km
-    at 4 mm/h, 1.1 km at 25, 0.7 km at 50). The visibility given is the air's whole extinction for the cameras and
-    the LiDAR, the rain's drops included, and is kept; such a one lets them see through the rain as through clearer
-    air (the LiDAR takes the rain through the visibility alone). A warning, not an error: real drop sizes stray from
-    Marshall and Palmer's, and a test may hold the air fixed on purpose."""
-    from mmusv.world.rain import rain_extinction_per_m
+    alone allow: the visibility in rain of air otherwise clear, ``3 / σ_rain`` for Marshall–Palmer drops
+    (:func:`mmusv.world.rain.visibility_in_rain`: 3.4 km at 4 mm/h, 1.1 km at 25, 0.7 km at 50). The visibility
+    given is the air's whole extinction for the cameras and the LiDAR, the rain's drops included, and is kept; such
+    a one lets them see through the rain as through clearer air (the LiDAR takes the rain through the visibility
+    alone). A warning, not an error: real drop sizes stray from Marshall and Palmer's, and a test may hold the air
+    fixed on purpose."""
+    from mmusv.world.rain import visibility_in_rain
 
     env = scenario.environment
     found: list[str] = []
     if env.visibility_m is None:
         return found
     weather = env.resolve().weather
-    sigma = rain_extinction_per_m(weather.rain_mm_per_h)
-    if sigma > 0.0 and env.visibility_m > 3.0 / sigma:
+    if weather.rain_mm_per_h <= 0.0:
+        return found
+    limit = visibility_in_rain(math.inf, weather.rain_mm_per_h)
+    if env.visibility_m > limit:
         found.append(
             f"{source}: environment.visibility_m = {env.visibility_m:g} is clearer than rain of "
             f"{weather.rain_mm_per_h:g} mm/h allows: its drops alone (Marshall-Palmer) limit the visibility to "
-            f"{3.0 / sigma:.0f} m, and the cameras' air and the LiDAR take the visibility given, drops included; "
+            f"{limit:.0f} m, and the cameras' air and the LiDAR take the visibility given, drops included; "
             "lower visibility_m, or leave it out (the weather's air with the rain's drops in it)"
         )
     for w in found:
