@@ -56,6 +56,10 @@ pub(super) struct Phasors<'a> {
     /// summing every component, `([j · nc + c] re, im)` in `f32`: the same for every tile of the level, so made
     /// once per frame.
     rows_f32: Vec<(Vec<f32>, Vec<f32>)>,
+    /// Per table of `powers` (levels, then the detail grid), the column rotations `e^{i kx d i}` apart, as
+    /// [`spread`] reads them: `([c · s + i] re, im)` with `s` the table's `w` nodes padded to whole groups of
+    /// [`LANES`] (zeros in the padding).
+    cols_soa: Vec<(Vec<f64>, Vec<f64>)>,
 }
 
 impl<'a> Phasors<'a> {
@@ -116,7 +120,24 @@ impl<'a> Phasors<'a> {
                 (fr, fi)
             })
             .collect();
-        Self { comps, x0, y0, tile_m, col, row, powers, rows_f32 }
+        let cols_soa = powers
+            .iter()
+            .enumerate()
+            .map(|(l, table)| {
+                let w = cells(l) + 1;
+                let stride = w.div_ceil(LANES) * LANES;
+                let (mut re, mut im) = (vec![0f64; stride * nc], vec![0f64; stride * nc]);
+                for c in 0..nc {
+                    for i in 0..w {
+                        let q = table[c * w + i].0;
+                        re[c * stride + i] = q.0;
+                        im[c * stride + i] = q.1;
+                    }
+                }
+                (re, im)
+            })
+            .collect();
+        Self { comps, x0, y0, tile_m, col, row, powers, rows_f32, cols_soa }
     }
 
     /// Samples tile `(ix, iy)`: its level from the distance of its centre to the nearest focus, flat when wholly
@@ -290,15 +311,12 @@ impl<'a> Phasors<'a> {
         let (mut fr, mut fi) =
             if shared.is_some() { (Vec::new(), Vec::new()) } else { (vec![0f32; w * nt], vec![0f32; w * nt]) };
         let mut k = vec![[0f32; 2]; nt];
+        let corner: Vec<(usize, C64)> =
+            terms.iter().map(|&(c, _)| (c, cmul(self.col[ix * nc + c], self.row[iy * nc + c]))).collect();
+        let (qr, qi) = &self.cols_soa[level];
+        spread(&corner, (qr, qi), (&mut ar, &mut ai));
         for (t, &(c, kc)) in terms.iter().enumerate() {
             let pw = &table[c * w..(c + 1) * w];
-            let p = cmul(self.col[ix * nc + c], self.row[iy * nc + c]);
-            for (i, q) in pw.iter().enumerate() {
-                let v = cmul(p, q.0);
-                let at = ((i / LANES) * nt + t) * LANES + i % LANES;
-                ar[at] = v.0 as f32;
-                ai[at] = v.1 as f32;
-            }
             if shared.is_none() {
                 for (i, q) in pw.iter().enumerate() {
                     fr[i * nt + t] = q.1 .0 as f32;
@@ -313,6 +331,34 @@ impl<'a> Phasors<'a> {
         let (mut sx, mut sy) = (vec![0f32; slope_len], vec![0f32; slope_len]);
         accumulate((&ar, &ai), (fr, fi), &k, (&mut eta, &mut sx, &mut sy));
         (eta, sx, sy, stride)
+    }
+}
+
+crate::dispatch! {
+    /// Spreads each term's phasor along a tile's bottom row into [`accumulate`]'s `row` layout: for term `t`
+    /// (component `c`, phasor `p` at the tile's corner, `corner[t] = (c, p)`), `p · e^{i kx d i}` at node column
+    /// `i` (`cols` as [`Phasors`] keeps them, per component a row of whole groups of [`LANES`]) into `out` at
+    /// `[(g · nt + t) · LANES + l]` for `i = g · LANES + l`, rounded to `f32` (the padding lanes get `p · 0`,
+    /// summed and never read). The same products as one complex multiplication per node (no fused multiply-adds):
+    /// the same bits, a whole group at a time; compiled for AVX2 where the CPU has it.
+    fn spread(corner: &[(usize, C64)], cols: (&[f64], &[f64]), out: (&mut [f32], &mut [f32])) {
+        let nt = corner.len();
+        let (ar, ai) = out;
+        if nt == 0 {
+            return;
+        }
+        let groups = ar.len() / (nt * LANES);
+        let stride = groups * LANES;
+        for (t, &(c, p)) in corner.iter().enumerate() {
+            let (qr, qi) = (&cols.0[c * stride..(c + 1) * stride], &cols.1[c * stride..(c + 1) * stride]);
+            for (g, (gr, gi)) in qr.chunks_exact(LANES).zip(qi.chunks_exact(LANES)).enumerate() {
+                let at = (g * nt + t) * LANES;
+                let re: [f32; LANES] = std::array::from_fn(|l| (p.0 * gr[l] - p.1 * gi[l]) as f32);
+                let im: [f32; LANES] = std::array::from_fn(|l| (p.0 * gi[l] + p.1 * gr[l]) as f32);
+                ar[at..at + LANES].copy_from_slice(&re);
+                ai[at..at + LANES].copy_from_slice(&im);
+            }
+        }
     }
 }
 
