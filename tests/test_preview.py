@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 import yaml
 from mmusv.acquire import run
-from mmusv.preview import _RING, _TITLE_H, BOX_COLOUR, _font, _rings, compose_preview
+from mmusv.preview import _RING, _TITLE_H, BOX_COLOUR, _bev_half_extent, _font, _rings, compose_preview
 from mmusv.recording import frame_messages, read_info, topics
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -116,6 +117,18 @@ def test_3d_box_footprints_in_the_bev(recording: Path) -> None:
             assert _is_box(arr[v - 2 : v + 3, u - 2 : u + 3]).any(), f"corner of {box.target_id} not drawn"
             drawn += 1
     assert drawn >= 1
+
+
+@pytest.mark.parametrize("reach_m", [0.0, 50.0, 95.0, 130.0, 200.0, 226.0, 310.0, 480.0, 640.0, 900.0])
+def test_the_bev_holds_every_box_and_not_much_more(reach_m: float) -> None:
+    """The BEV square holds every box centre with a tenth to spare, and is at most a quarter wider than that (a
+    target at 200 m in a ±500 m square left a 200 m LiDAR's points in its middle fifth), from 100 m to 1,000 m."""
+    boxes = [SimpleNamespace(center=(0.3 * reach_m, -reach_m, 1.0)), SimpleNamespace(center=(10.0, 5.0, 0.0))]
+    half = _bev_half_extent(boxes)
+    need = max(1.1 * reach_m, 100.0)
+    assert half >= min(need, 1000.0)
+    assert half <= max(1.25 * need, 100.0) or half == 100.0
+    assert half <= 1000.0
 
 
 def test_ppi_ring_scale_from_the_recording(recording: Path) -> None:

@@ -166,11 +166,17 @@ def _pictured(topic: str, agent: str) -> bool:
     )
 
 
+# Round half sides of the BEV square per decade: at most a quarter wider than what they hold (1-2-5 steps left a
+# 200 m LiDAR's points in the middle fifth of a ±500 m square).
+_BEV_STEPS = (1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0)
+
+
 def _bev_half_extent(boxes: list[Any]) -> float:
-    """Half side (m) of the BEV square: ``_BEV_HALF_M``, widened to a 1-2-5 value that holds every box centre."""
+    """Half side (m) of the BEV square: ``_BEV_HALF_M``, widened to the least round value (``_BEV_STEPS`` per
+    decade) that holds every box centre with a tenth to spare, at most 1,000 m."""
     reach = max([max(abs(b.center[0]), abs(b.center[1])) * 1.1 for b in boxes] + [_BEV_HALF_M])
     base = 10.0 ** math.floor(math.log10(reach))
-    return min(next(base * k for k in (1.0, 2.0, 5.0, 10.0) if base * k >= reach), 1000.0)
+    return min(next(base * k for k in _BEV_STEPS if base * k >= reach), 1000.0)
 
 
 def _ppi_panel(img: np.ndarray, px: int, metres_per_pixel: float | None) -> tuple[Image.Image, float]:
