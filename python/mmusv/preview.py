@@ -168,7 +168,7 @@ def _pictured(topic: str, agent: str) -> bool:
 
 # Round half sides of the BEV square per decade: at most a quarter wider than what they hold (1-2-5 steps left a
 # 200 m LiDAR's points in the middle fifth of a ±500 m square).
-_BEV_STEPS = (1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0)
+_BEV_STEPS = (1.0, 1.25, 1.5, 1.75, 2.0, 2.5, 3.0, 3.5, 4.0, 5.0, 6.0, 7.0, 8.0, 10.0)
 
 
 def _bev_half_extent(boxes: list[Any]) -> float:
