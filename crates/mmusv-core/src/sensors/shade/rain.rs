@@ -93,6 +93,9 @@ pub const MIN_COVERAGE: f32 = 1.0 / 255.0;
 pub const PIXEL_PITCH_M: f32 = 3.45e-6;
 /// Most steps along one streak (its coverage is spread over them).
 const MAX_STEPS: usize = 4096;
+/// Most sub-steps across a drop's blur disc (per side): the disc is sampled `side × side` times, `side` its width
+/// in pixels rounded up, clamped to `1..=MAX_SIDE`.
+const MAX_SIDE: usize = 16;
 
 /// Terminal fall velocity (m/s) of a drop of diameter `d_mm` (mm) in still air at sea level (Gunn & Kinzer 1949,
 /// Atlas et al. 1973's fit; 0 for a drop too small for the fit).
@@ -267,9 +270,9 @@ pub fn coverage(
         // image (one, at the centre, for a drop narrower than a pixel).
         let steps = (drop.streak_px().ceil() as usize + 1).min(MAX_STEPS);
         let spread = drop.spread_px();
-        let side = (spread.ceil() as usize).clamp(1, 16);
-        // The sub-step offsets across (at most 16: an array, not an allocation per drop on this hot path).
-        let mut offsets = [0f32; 16];
+        let side = (spread.ceil() as usize).clamp(1, MAX_SIDE);
+        // The sub-step offsets across (at most MAX_SIDE: an array, not an allocation per drop on this hot path).
+        let mut offsets = [0f32; MAX_SIDE];
         for (k, o) in offsets.iter_mut().enumerate().take(side) {
             *o = ((k as f32 + 0.5) / side as f32 - 0.5) * spread;
         }
