@@ -113,7 +113,8 @@ ENV_KW = [("sun_direction", "[0.3, 0.2, 0.93]", "q"), ("turbidity", "3.0", "f"),
 LIDAR_KW = [("elevations", "[-0.2, 0.0, 0.2]", "q"), ("azimuth_steps", "16", "i"), ("range_min", "0.5", "f"),
             ("range_max", "100.0", "f"), ("range_noise_std", "0.01", "f"), ("dropout", "0.0", "f"),
             ("water_probability", "0.1", "f"), ("water_probability_per_wave_m", "0.1", "f"),
-            ("water_range_m", "20.0", "f"), ("water_range_per_wave_m", "5.0", "f")]  # fmt: skip
+            ("water_range_m", "20.0", "f"), ("water_range_per_wave_m", "5.0", "f"),
+            ("beam_divergence", "0.003", "f")]  # fmt: skip
 RADAR_KW = [("range_min_m", "5.0", "f"), ("range_max_m", "500.0", "f"), ("range_resolution_m", "5.0", "f"),
             ("azimuth_bins", "64", "i"), ("beamwidth_az_rad", "0.03", "f"), ("elevation_fan_rad", "(-0.2, 0.2)", "q"),
             ("rays_az", "64", "i"), ("rays_el", "4", "i"), ("target_rays", "16", "i"), ("horizon_fraction", "0.5", "f"),
@@ -844,7 +845,7 @@ ENV = dict(sun_direction=[0.3, 0.2, 0.93], turbidity=3.0, cloud_cover=0.0, groun
            rain_mm_per_h=0.0, wave_height_m=0.5, wind_speed_m_s=3.0, water_albedo=[0.004, 0.018, 0.03])
 LIDAR = dict(elevations=[-0.2, 0.0, 0.2], azimuth_steps=16, range_min=0.5, range_max=100.0, range_noise_std=0.01,
              dropout=0.0, water_probability=0.1, water_probability_per_wave_m=0.1, water_range_m=20.0,
-             water_range_per_wave_m=5.0)
+             water_range_per_wave_m=5.0, beam_divergence=0.003)
 RADAR = dict(range_min_m=5.0, range_max_m=500.0, range_resolution_m=5.0, azimuth_bins=64, beamwidth_az_rad=0.03,
              elevation_fan_rad=(-0.2, 0.2), rays_az=64, rays_el=4, target_rays=16, horizon_fraction=0.5, horizon_band_rad=0.05,
              detection_threshold=1e-3, range_noise_std_m=0.5, sea_sigma0_at_1m=1e-4, critical_range_per_m=100.0,

@@ -27,7 +27,8 @@ def clear_env(sun: np.ndarray | tuple[float, float, float] = (0.3, 0.2, 0.93), *
 
 def clear_lidar(*, channels: int, azimuth_steps: int) -> core.Lidar:
     """A LiDAR of ``channels`` beams fanned over ±0.3° and ``azimuth_steps`` columns, 0.5–2,000 m, with no range
-    noise, no dropout and no water returns: every loss a test measures is the environment's."""
+    noise, no dropout, no water returns and a line for a beam (no rain drop returns): every loss a test measures is
+    the environment's."""
     return core.Lidar(
         elevations=list(core.uniform_elevations(channels=channels, lower=-0.3, upper=0.3)),
         azimuth_steps=azimuth_steps,
@@ -39,4 +40,5 @@ def clear_lidar(*, channels: int, azimuth_steps: int) -> core.Lidar:
         water_probability_per_wave_m=0.0,
         water_range_m=0.0,
         water_range_per_wave_m=0.0,
+        beam_divergence=0.0,
     )

@@ -1,7 +1,7 @@
 """mmusv.scenario_checks.check_sensors: a scenario that records no sensor at all is said so, once, as a warning (the
 malformed-input review's: ``preset: lidar_only`` with ``lidar: null``, or no vessel with ``role: usv``, ran without a
 word and recorded the world state only). check_rain_visibility: a visibility given clearer than its rain's drops
-alone allow is said so (it was kept without a word, and the LiDAR takes the rain through the visibility alone)."""
+alone allow is said so (it was kept without a word, and the LiDAR dims in rain by the visibility alone)."""
 
 from __future__ import annotations
 

@@ -333,6 +333,7 @@ class Lidar:
         water_probability_per_wave_m: float,
         water_range_m: float,
         water_range_per_wave_m: float,
+        beam_divergence: float,
     ) -> Lidar: ...
     @property
     def num_rays(self) -> int:
@@ -348,10 +349,11 @@ class Lidar:
         seed: int,
         wakes: npt.NDArray[np.float32] | None = None,
     ) -> dict[str, npt.NDArray[Any]]:
-        """One sweep: xyz (N,3) f32 LiDAR frame, range, intensity, ring, azimuth, class, instance, ray_index; and
-        beam_instance (M,) i32, per ray of the full pattern the instance its cast met first (-1: none). ``wakes``
-        (K, 6) to (K, 9) float32 ``x, y, heading, speed, length, beam[, reach_m[, age_s[, displacement_m3]]]`` rows (see
-        ``Camera.render``): vessels under way, whose wake foam returns over a wave surface."""
+        """One sweep: xyz (N,3) f32 LiDAR frame, range, intensity, ring, azimuth, class (0: a rain drop), instance
+        (-1: a rain drop), ray_index; and beam_instance (M,) i32, per ray of the full pattern the instance its cast
+        met first (-1: none). ``wakes`` (K, 6) to (K, 9) float32
+        ``x, y, heading, speed, length, beam[, reach_m[, age_s[, displacement_m3]]]`` rows (see ``Camera.render``):
+        vessels under way, whose wake foam returns over a wave surface."""
 
 @final
 class Camera:

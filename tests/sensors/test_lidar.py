@@ -5,8 +5,9 @@
   face hit belongs to the point's instance, rays without a point are misses there.
 * Pattern bookkeeping: ring / azimuth / ray_index / elevation of each point, explicit elevation tables.
 * Noise model: seeding, Gaussian range noise, dropout, water returns versus wave height, fog losses (rain's
-  through its visibility alone), and the intensity formula ``ρ(class) · |cos θ| · τ / (1 + (r / 100 m)²)``,
-  checked analytically on simple scenes (a closed room whose every ray hits, a lone water plane).
+  through its visibility alone), the rain drops' own returns against a NumPy re-draw of LISA's model, and the
+  intensity formula ``ρ(class) · |cos θ| · τ / (1 + (r / 100 m)²)``, checked analytically on simple scenes (a
+  closed room whose every ray hits, a lone water plane).
 """
 
 from __future__ import annotations
@@ -78,6 +79,7 @@ def exact_lidar(channels: int = 32, steps: int = 720, *, range_m: float = 200.0,
         "water_probability_per_wave_m": 0.0,
         "water_range_m": 1e6,
         "water_range_per_wave_m": 0.0,
+        "beam_divergence": 0.0,
     }
     args.update(kw)
     return core.Lidar(**args)
@@ -408,7 +410,8 @@ def test_rain_dims_the_lidar_through_the_visibility_alone() -> None:
     """The drops extinguish 905 nm as they do visible light, and the visibility in rain holds them
     (:mod:`mmusv.world.rain`): a LiDAR in 50 mm/h loses the returns that the rain's visibility loses, and the rain
     rate adds no second loss (until 2026-12-07 an unsourced ``1e-5·R^0.6`` per metre was added to the visibility's
-    extinction, the drops counted twice: the scans differed)."""
+    extinction, the drops counted twice: the scans differed). A line for a beam (divergence 0) meets no drop; the
+    drops' own returns are the test below."""
     weather = Weather.make("rain", rain_mm_per_h=50.0)
     sigma = weather.extinction_per_m
     assert 2.5e-3 < sigma < 6e-3  # the drops alone: 0.365·50^0.63 per km, 4.1e-3 per metre; and the air's
@@ -422,6 +425,85 @@ def test_rain_dims_the_lidar_through_the_visibility_alone() -> None:
     # The rain rate without its visibility (clear air) dims nothing.
     rate_alone = do_scan(lidar, room_scene(), seed=5, rain_mm_per_h=100.0)
     np.testing.assert_array_equal(rate_alone.intensity, clear.intensity)
+
+
+def _lisa_brute_share(
+    p0: np.ndarray,
+    reach: np.ndarray,
+    *,
+    rain: float,
+    sigma: float,
+    divergence: float,
+    range_min: float,
+    range_max: float,
+    rng: np.random.Generator,
+) -> np.ndarray:
+    """Per beam, whether LISA's hybrid Monte Carlo (Kilic et al. 2021, ``lisa_mc``, *strongest* mode) puts a drop
+    in place of its return: every drop of the beam's cone (Marshall–Palmer sizes from 0.05 mm, ranges from the
+    cone's ``s²`` law, a Poisson count), the strongest replacing a return of power ``p0`` when it beats it and
+    ``0.9 / range_max²``. Drawn out to ``min(reach, √(ρ_w / P_min))``: no drop beyond can beat ``P_min``."""
+    rho_w = ((1.328 - 1) / (1.328 + 1)) ** 2
+    p_min = 0.9 / range_max**2
+    lam = 4.1 * rain**-0.21
+    per_m3 = 8000.0 * math.exp(-lam * 0.05) / lam
+    top = np.minimum(reach, math.sqrt(rho_w / p_min))
+    counts = rng.poisson(per_m3 * math.pi / 3 * top * (divergence * top / 2) ** 2)
+    beam = np.repeat(np.arange(len(p0)), counts)
+    s = top[beam] * rng.random(len(beam)) ** (1 / 3)
+    d_mm = 0.05 + rng.exponential(1 / lam, len(beam))
+    power = rho_w * np.minimum((d_mm / (1e3 * divergence * s)) ** 2, 1) * np.exp(-2 * sigma * s) / s**2
+    power = np.where(s > range_min, power, 0.0)
+    best = np.zeros(len(p0))
+    np.maximum.at(best, beam, power)
+    return best > np.maximum(p0, p_min)
+
+
+@pytest.mark.parametrize("rain", [10.0, 50.0])
+def test_rain_drops_return_as_lisa_draws_them(rain: float) -> None:
+    """In rain a diverging beam's drops return (LISA's model, ``lidar_rain.rs``): the share of beams whose return is
+    a drop (class 0, instance -1) matches a NumPy re-implementation of LISA's brute-force draw of every drop in
+    every beam within 4.5 standard errors, beam by beam from the dry scan's own returns; those points lie between
+    the minimum range and 0.149 of the range; more rain, more of them; without rain none."""
+    sigma = Weather.make("rain", rain_mm_per_h=rain).extinction_per_m
+    lidar = exact_lidar(32, 720, range_min=0.5, beam_divergence=3e-3)
+    dry = do_scan(lidar, room_scene(), seed=4, fog_extinction_per_m=sigma)
+    wet = do_scan(lidar, room_scene(), seed=4, fog_extinction_per_m=sigma, rain_mm_per_h=rain)
+    drop = wet.semantic_class == 0
+    assert (wet.instance[drop] == -1).all() and (wet.instance[~drop] >= 0).all()
+    assert (wet.range[drop] >= 0.5).all() and (wet.range[drop] <= 0.149 * 200.0).all()
+    # The dry scan's power per beam, LISA's units: the intensity without its near-range factor, over r².
+    r = dry.range.astype(np.float64)
+    p0 = np.zeros(lidar.num_rays)
+    p0[dry.ray_index] = dry.intensity * (1 + (r / 100) ** 2) / r**2
+    reach, _ = room_truth(np.asarray(lidar.pattern(), dtype=np.float64))
+    assert np.isfinite(reach).all()  # every beam meets the room (its return lost to the air's extinction or not)
+    brute = _lisa_brute_share(
+        p0, reach, rain=rain, sigma=sigma, divergence=3e-3, range_min=0.5, range_max=200.0,
+        rng=np.random.default_rng(11),
+    )  # fmt: skip
+    n = lidar.num_rays
+    got, want = drop.sum() / n, brute.mean()
+    se = math.sqrt(got * (1 - got) / n + want * (1 - want) / n)
+    assert drop.sum() > 100 and abs(got - want) < 4.5 * se, f"{rain} mm/h: {got:.4f} of beams vs LISA {want:.4f}"
+    # Where no drop won, the return is the dry one to the bit.
+    kept = np.isin(dry.ray_index, wet.ray_index[~drop])
+    np.testing.assert_array_equal(dry.intensity[kept], wet.intensity[~drop])
+    # The default LiDAR config has a diverging beam, and passes it on; negative is refused naming the field.
+    assert LidarConfig().beam_divergence_mrad == 3.0
+    with pytest.raises(ValueError, match="beam_divergence_mrad"):
+        LidarConfig(beam_divergence_mrad=-1.0)
+    for mrad, any_drop in ((3.0, True), (0.0, False)):
+        made = lidar_from_config(LidarConfig(points_per_second=32 * 720 * 5.0, beam_divergence_mrad=mrad))
+        assert (do_scan(made, room_scene(), seed=4, rain_mm_per_h=50.0).semantic_class == 0).any() == any_drop
+
+
+def test_more_rain_more_drop_returns() -> None:
+    lidar = exact_lidar(32, 720, range_min=0.5, beam_divergence=3e-3)
+    counts = [
+        int((do_scan(lidar, room_scene(), seed=4, rain_mm_per_h=rate).semantic_class == 0).sum())
+        for rate in (0.0, 2.0, 10.0, 50.0)
+    ]
+    assert counts[0] == 0 and counts == sorted(counts) and counts[-1] > 2 * counts[1], counts
 
 
 @pytest.mark.parametrize(("fog", "rain"), [(0.0, 0.0), (0.004, 0.0), (0.004, 50.0)])

@@ -302,6 +302,7 @@ def test_lidar_water_returns_follow_incidence_and_are_speckle_above_the_threshol
     lidar = core.Lidar(
         elevations=el, azimuth_steps=2048, range_min=0.5, range_max=120.0, range_noise_std=0.0, dropout=0.0,
         water_probability=0.05, water_probability_per_wave_m=0.1, water_range_m=0.0, water_range_per_wave_m=0.0,
+        beam_divergence=3e-3,
     )  # fmt: skip
     pose = mast(3.0)
     wind = 8.0
@@ -350,7 +351,7 @@ def test_lidar_points_stay_within_the_range_gates() -> None:
         return core.Lidar(
             elevations=el, azimuth_steps=3600, range_min=range_min, range_max=range_max, range_noise_std=0.05,
             dropout=0.0, water_probability=0.0, water_probability_per_wave_m=0.0, water_range_m=0.0,
-            water_range_per_wave_m=0.0,
+            water_range_per_wave_m=0.0, beam_divergence=3e-3,
         )  # fmt: skip
 
     env = calm(0.0)

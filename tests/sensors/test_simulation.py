@@ -530,6 +530,7 @@ def test_native_lidar_misconfig_names_the_field() -> None:
         "water_probability_per_wave_m": 0.1,
         "water_range_m": 20.0,
         "water_range_per_wave_m": 10.0,
+        "beam_divergence": 3e-3,
     }
     core.Lidar(**ok)
     for change, field in [
@@ -541,6 +542,8 @@ def test_native_lidar_misconfig_names_the_field() -> None:
         ({"water_probability": -0.1}, "lidar.water_probability"),
         ({"range_noise_std": float("nan")}, "lidar.range_noise_std_m"),
         ({"azimuth_steps": 0}, "lidar.azimuth_steps"),
+        ({"beam_divergence": -1e-3}, "lidar.beam_divergence"),
+        ({"beam_divergence": float("inf")}, "lidar.beam_divergence"),
         ({"elevations": [0.0, math.pi / 2]}, "elevations"),
     ]:
         with pytest.raises(mmusv.errors.ConfigError, match=field.replace(".", r"\.")):

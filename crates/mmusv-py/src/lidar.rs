@@ -23,7 +23,7 @@ pub struct Lidar {
 impl Lidar {
     #[new]
     #[pyo3(signature = (*, elevations, azimuth_steps, range_min, range_max, range_noise_std, dropout,
-        water_probability, water_probability_per_wave_m, water_range_m, water_range_per_wave_m))]
+        water_probability, water_probability_per_wave_m, water_range_m, water_range_per_wave_m, beam_divergence))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         elevations: Vec<f64>,
@@ -36,6 +36,7 @@ impl Lidar {
         water_probability_per_wave_m: f32,
         water_range_m: f32,
         water_range_per_wave_m: f32,
+        beam_divergence: f32,
     ) -> PyResult<Self> {
         let cfg = lidar::LidarConfig {
             elevations,
@@ -48,6 +49,7 @@ impl Lidar {
             water_probability_per_wave_m,
             water_range_m,
             water_range_per_wave_m,
+            beam_divergence,
         };
         Ok(Self { inner: lidar::Lidar::new(cfg).map_err(crate::errors::to_py)? })
     }
@@ -64,9 +66,9 @@ impl Lidar {
     }
 
     /// One sweep on the current state of `scene` from the LiDAR at `pose` (4×4 LiDAR → world) in `env` (the fog
-    /// extinction, the rain's drops included, waves and wind are used). Returns a dict
+    /// extinction, the rain's drops included, waves, wind and the rain rate are used). Returns a dict
     /// of equal-length columns: xyz (N,3) f32 LiDAR frame, range, intensity (f32), ring (u16), azimuth (f32
-    /// rad), class (u16), instance (i32), ray_index (u32); and beam_instance (M,) i32: per ray of the full
+    /// rad), class (u16; 0 for a rain drop's return), instance (i32; -1 for a drop), ray_index (u32); and beam_instance (M,) i32: per ray of the full
     /// pattern, the instance its cast met first within the range (-1: none). `wakes` (K, 6) to (K, 9) float32
     /// rows `x, y, heading, speed, length, beam[, reach_m[, age_s[, displacement_m3]]]` (world metres, radians,
     /// m/s, s, m³; see `Camera.render`): the vessels under way, whose wake foam returns over a wave surface.

@@ -89,6 +89,7 @@ def lidar_from_config(cfg: LidarConfig) -> core.Lidar:
         water_probability_per_wave_m=cfg.water_probability_per_wave_m,
         water_range_m=cfg.water_range_m,
         water_range_per_wave_m=cfg.water_range_per_wave_m,
+        beam_divergence=cfg.beam_divergence_mrad * 1e-3,
     )
 
 

@@ -163,8 +163,9 @@ class Weather:
     the rain rate (:meth:`make`, :mod:`mmusv.world.rain`) — Marshall–Palmer drops alone make it about
     3 / (0.365 R^0.63) km, 3.4 km at 4 mm/h, 1.9 km at 10, 0.7 km at 50. The rain rate
     itself sets the drops the cameras see near their lens (frozen dots by day, faint streaks in a long exposure:
-    ``crates/mmusv-core/src/sensors/shade/rain.rs``) and the radar's rain attenuation and clutter; the LiDAR takes
-    the rain through the visibility alone (``crates/mmusv-core/src/sensors/lidar.rs``, step 4)."""
+    ``crates/mmusv-core/src/sensors/shade/rain.rs``), the radar's rain attenuation and clutter, and the drops that
+    return in a LiDAR's beam (``crates/mmusv-core/src/sensors/lidar_rain.rs``); the LiDAR's attenuation is the
+    visibility's alone (``crates/mmusv-core/src/sensors/lidar.rs``, step 4)."""
 
     kind: WeatherKind
     visibility_m: float

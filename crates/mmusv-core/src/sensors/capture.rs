@@ -22,13 +22,14 @@ use crate::sky_visibility::SkyVisibility;
 use rayon::prelude::*;
 use std::time::Instant;
 
-/// What the LiDAR takes of the environment: the air's extinction (fog and rain, from the visibility), waves and
-/// wind.
+/// What the LiDAR takes of the environment: the air's extinction (fog and rain, from the visibility), waves,
+/// wind and the rain rate (the drops that return).
 pub fn lidar_env(env: &ShadeEnv) -> LidarEnv {
     LidarEnv {
         fog_extinction_per_m: env.fog_extinction_per_m,
         wave_height_m: env.wave_height_m,
         wind_speed_m_s: env.wind_speed_m_s,
+        rain_mm_per_h: env.rain_mm_per_h,
     }
 }
 

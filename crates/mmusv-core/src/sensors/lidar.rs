@@ -7,7 +7,7 @@
 //!
 //! Per ray, in this order (each random draw is a pure function of `(seed, ray index)`, see [`noise`]):
 //! 1. the exact hit (distance `r`, normal `n`, class, instance) or a miss; the cast reaches `range_max + 6σ`
-//!    (`σ = range_noise_std`), so that step 6 meets the ranges that noise brings inside `range_max` too;
+//!    (`σ = range_noise_std`), so that step 7 meets the ranges that noise brings inside `range_max` too;
 //! 2. no hit: no return;
 //! 3. open water (class 1): on a scene with a displaced wave surface ([`crate::Scene::wave_surface`]), a return
 //!    with the probability of the physical model in [`super::lidar_water`] (quasi-specular glints off the wave
@@ -31,14 +31,19 @@
 //!    itself adds nothing here. Until 2026-12-07 a second rain term `1e-5 · R^0.6` per metre, without a source,
 //!    was added to `σ` (2.4–2.7 % of the drops' own extinction over 1–50 mm/h, counted twice); the same numbers,
 //!    `0.01 · R^0.6`, are the rain extinction that the LISA code (Kilic et al. 2021, arXiv:2107.07004,
-//!    `velatkilic/LISA`) attributes to Goodin et al. (2019), Electronics 8(1), 89, applied per metre. Not
-//!    modelled: the returns of the drops themselves near the sensor (LISA's), which a real LiDAR reports in
-//!    heavy rain. The return is lost with probability `1 − τ` — but for the physical water returns of step 3,
+//!    `velatkilic/LISA`) attributes to Goodin et al. (2019), Electronics 8(1), 89, applied per metre. The
+//!    return is lost with probability `1 − τ` — but for the physical water returns of step 3,
 //!    whose speckle threshold already met the attenuated mean `τ ⟨I⟩` (until 2026-12-01 they were lost with
 //!    probability `1 − τ` as well, the fog counted twice: at 600 m visibility a fifth fewer water returns 20 m out
 //!    than the model gives, a third 40 m out);
-//! 5. random dropout with probability `dropout`;
-//! 6. range noise: `r' = r + N(0, range_noise_std)` (not below 0); a measured range `r' < range_min` or
+//! 5. rain drops (`LidarEnv::rain_mm_per_h` > 0 and a `beam_divergence` > 0): the strongest drop in the beam's
+//!    cone, nearer than what the beam met (anywhere within range where it met nothing), replaces the return
+//!    where its power exceeds the return's and the receiver's threshold (LISA's hybrid Monte-Carlo model,
+//!    [`super::lidar_rain`]): a point of class 0 and no instance, its intensity the same law below with the
+//!    drop's reflectivity at normal incidence. Without rain the scan is the same to the bit as before the drops
+//!    were modelled (2026-12-08; until then the drops only dimmed the air);
+//! 6. random dropout with probability `dropout`;
+//! 7. range noise: `r' = r + N(0, range_noise_std)` (not below 0); a measured range `r' < range_min` or
 //!    `r' > range_max` gives no return (the sensor gates on what it measures: no point's range lies outside
 //!    `[range_min, range_max]`; until 2026-12-01 the gate took the exact `r` and noise put points beyond both
 //!    limits); the point is `origin + r' · d` in the LiDAR frame.
@@ -60,6 +65,7 @@
 //!   linear in target reflectivity). Against a range-independent `ρ |cos θ| τ` ours is 4 % low at 20 m, 20 % at
 //!   50 m, 50 % at 100 m and 80 % at 200 m: the intensity is neither a raw power nor a calibrated reflectivity.
 
+use super::lidar_rain::RainDrops;
 use super::lidar_water;
 use super::noise::{self, stream};
 use super::rays;
@@ -67,7 +73,7 @@ use super::shade::foam::{Foam, FOAM_SEED};
 use super::shade::wake::Wake;
 use crate::error::{MmusvError, Result};
 use crate::geometry::RigidPose;
-use crate::scene::{Scene, NO_HIT};
+use crate::scene::{Scene, CLASS_NONE, NO_HIT};
 use parry3d::math::Vec3;
 
 /// Semantic class of open water (see `mmusv.classes`).
@@ -96,7 +102,13 @@ pub struct LidarConfig {
     pub water_range_m: f32,
     /// Increase of that distance per metre of wave height (metres per metre, ≥ 0).
     pub water_range_per_wave_m: f32,
+    /// Full angle of the beam's divergence (radians, in `[0, 0.1]`): the cone in which rain drops return
+    /// ([`super::lidar_rain`]); 0 meets no drop.
+    pub beam_divergence: f32,
 }
+
+/// The beam divergence of [`LidarConfig::default`]: 3 mrad, LISA's (Kilic et al. 2021, [`super::lidar_rain`]).
+pub const DEFAULT_BEAM_DIVERGENCE: f32 = 3e-3;
 
 impl Default for LidarConfig {
     /// The paper's LiDAR (64 channels, 131,072 points/s at 5 Hz, 200 m) over mmusv's vertical field of
@@ -114,6 +126,7 @@ impl Default for LidarConfig {
             water_probability_per_wave_m: 0.1,
             water_range_m: 20.0,
             water_range_per_wave_m: 10.0,
+            beam_divergence: DEFAULT_BEAM_DIVERGENCE,
         }
     }
 }
@@ -161,6 +174,13 @@ impl LidarConfig {
                 return Err(MmusvError::config(name, v, "must be finite and >= 0"));
             }
         }
+        if !(self.beam_divergence.is_finite() && (0.0..=0.1).contains(&self.beam_divergence)) {
+            return Err(MmusvError::config(
+                "lidar.beam_divergence",
+                self.beam_divergence,
+                "must be a finite full angle in [0, 0.1] radians (0 meets no rain drop)",
+            ));
+        }
         for (name, v) in [("lidar.dropout", self.dropout), ("lidar.water_probability", self.water_probability)] {
             if !(0.0..=1.0).contains(&v) {
                 return Err(MmusvError::config(name, v, "a probability must be in [0, 1]"));
@@ -180,6 +200,9 @@ pub struct LidarEnv {
     pub wave_height_m: f32,
     /// Wind speed at 10 m (m/s): capillary roughness and whitecaps of the physical water returns.
     pub wind_speed_m_s: f32,
+    /// Rain rate (mm/h): the drops that return from within the beam ([`super::lidar_rain`]); their extinction is
+    /// in `fog_extinction_per_m`.
+    pub rain_mm_per_h: f32,
 }
 
 impl LidarEnv {
@@ -189,6 +212,7 @@ impl LidarEnv {
             ("lidar.fog_extinction_per_m", self.fog_extinction_per_m),
             ("lidar.wave_height_m", self.wave_height_m),
             ("lidar.wind_speed_m_s", self.wind_speed_m_s),
+            ("lidar.rain_mm_per_h", self.rain_mm_per_h),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(MmusvError::config(name, v, "must be finite and >= 0"));
@@ -337,14 +361,13 @@ impl Lidar {
         let within = |k: usize| if hits.distance[k] <= cfg.range_max { hits.instance[k] } else { NO_HIT };
         let mut out =
             LidarScan { beam_instance: slot.iter().map(|&k| within(k as usize)).collect(), ..LidarScan::default() };
-        for (i, &k) in slot.iter().enumerate() {
-            let k = k as usize;
+        // The return of the surface a beam met (its intensity), if any survives steps 2–4.
+        let surface = |k: usize, idx: u64| -> Option<f32> {
             let r = hits.distance[k];
             let class = hits.class[k];
             if !r.is_finite() || hits.instance[k] == NO_HIT {
-                continue;
+                return None;
             }
-            let idx = i as u64;
             // Clear air (no fog, no rain: `σ` 0) transmits all: `exp(-0)` is 1 to the bit, without the call per beam.
             let tau = if sigma > 0.0 { (-2.0 * sigma * r).exp() } else { 1.0 };
             let n = Vec3::new(hits.normal[3 * k], hits.normal[3 * k + 1], hits.normal[3 * k + 2]);
@@ -352,7 +375,7 @@ impl Lidar {
             let mut water_intensity = None;
             if class == CLASS_WATER {
                 if water_off {
-                    continue;
+                    return None;
                 } else if waves {
                     let foam = wake_foam.as_ref().map_or(0.0, |f| {
                         let p = Vec3::from_array(origin) + Vec3::from_array(dirs[k]) * r;
@@ -361,17 +384,52 @@ impl Lidar {
                     let mean = lidar_water::mean_intensity_with_foam(cos, env.wind_speed_m_s, r, tau, foam);
                     let u = noise::uniform(seed, stream::WATER, idx);
                     if u >= f64::from(lidar_water::detection_probability(mean)) {
-                        continue;
+                        return None;
                     }
                     water_intensity = Some(lidar_water::speckle_intensity(mean, u).clamp(0.0, 1.0));
                 } else if r > water_range || noise::uniform(seed, stream::WATER, idx) >= p_water {
-                    continue;
+                    return None;
                 }
             }
             // The physical water returns' detection already took the attenuated mean (step 3).
             if sigma > 0.0 && water_intensity.is_none() && noise::uniform(seed, stream::WEATHER, idx) >= tau as f64 {
-                continue;
+                return None;
             }
+            Some(water_intensity.unwrap_or_else(|| {
+                (reflectivity(class) * cos * tau / (1.0 + (r / 100.0) * (r / 100.0))).clamp(0.0, 1.0)
+            }))
+        };
+        let rain = RainDrops::new(
+            f64::from(env.rain_mm_per_h),
+            f64::from(cfg.beam_divergence),
+            f64::from(cfg.range_min),
+            f64::from(cfg.range_max),
+            f64::from(sigma),
+        );
+        for (i, &k) in slot.iter().enumerate() {
+            let k = k as usize;
+            let idx = i as u64;
+            // (range, intensity, class, instance) of the return.
+            let mut point =
+                surface(k, idx).map(|intensity| (hits.distance[k], intensity, hits.class[k], hits.instance[k]));
+            if let Some(rain) = &rain {
+                let met = hits.distance[k].is_finite() && hits.instance[k] != NO_HIT;
+                let reach = if met { f64::from(hits.distance[k]) } else { f64::INFINITY };
+                // The return's power in the drops' units: its intensity without the near-range factor, over r².
+                let p0 = point.map_or(0.0, |(r, intensity, _, _)| {
+                    let r = f64::from(r).max(1e-6);
+                    f64::from(intensity) * (1.0 + (r / 100.0) * (r / 100.0)) / (r * r)
+                });
+                if let Some(drop) = rain.strongest(reach, p0, seed, idx) {
+                    let s = drop.range;
+                    let tau = (-2.0 * f64::from(sigma) * s).exp();
+                    let intensity = (drop.reflectivity * tau / (1.0 + (s / 100.0) * (s / 100.0))).clamp(0.0, 1.0);
+                    point = Some((s as f32, intensity as f32, CLASS_NONE, NO_HIT));
+                }
+            }
+            let Some((r, intensity, class, instance)) = point else {
+                continue;
+            };
             if cfg.dropout > 0.0 && noise::uniform(seed, stream::DROPOUT, idx) < cfg.dropout as f64 {
                 continue;
             }
@@ -384,9 +442,6 @@ impl Lidar {
                 continue;
             }
             let d = self.pattern[i];
-            let intensity = water_intensity.unwrap_or_else(|| {
-                (reflectivity(class) * cos * tau / (1.0 + (r / 100.0) * (r / 100.0))).clamp(0.0, 1.0)
-            });
             let column = i / channels;
             out.xyz.push([d[0] * measured, d[1] * measured, d[2] * measured]);
             out.range.push(measured);
@@ -394,7 +449,7 @@ impl Lidar {
             out.ring.push((i % channels) as u16);
             out.azimuth.push((std::f64::consts::TAU * column as f64 / cfg.azimuth_steps as f64) as f32);
             out.class.push(class);
-            out.instance.push(hits.instance[k]);
+            out.instance.push(instance);
             out.ray_index.push(i as u32);
         }
         Ok(out)
@@ -447,6 +502,54 @@ mod tests {
         }
         // Only the forward half (|azimuth| < ~84°) can hit a wall 10 m away, 50 m wide.
         assert!(scan.azimuth.iter().all(|a| a.cos() > 0.0));
+    }
+
+    /// In rain, a beam that meets nothing returns from a drop with the probability `1 − e^(−μ)` of at least one
+    /// detectable drop along it (`μ` the drops' expected count, clear air so `τ` is 1 and every drop the count
+    /// holds is detected), as a point of class 0 with no instance within the drops' reach; beams that meet a wall
+    /// 2 m off return from drops only nearer than the wall; a line for a beam (divergence 0), or no rain, gives
+    /// the scan of clear air to the bit.
+    #[test]
+    fn rain_drops_return_as_often_as_the_model_says() {
+        let c = cfg(16, 3600);
+        let lidar = Lidar::new(c.clone()).unwrap_or_else(|e| unreachable!("{e}"));
+        let rain = LidarEnv { rain_mm_per_h: 20.0, ..LidarEnv::default() };
+        let s = wall_scene(150.0);
+        let wet = lidar.scan(&s, &RigidPose::IDENTITY, &rain, 8).unwrap_or_else(|e| unreachable!("{e}"));
+        let dry = lidar.scan(&s, &RigidPose::IDENTITY, &LidarEnv::default(), 8).unwrap_or_else(|e| unreachable!("{e}"));
+        let drops = RainDrops::new(20.0, 3e-3, 0.5, 200.0, 0.0).unwrap_or_else(|| unreachable!());
+        let misses: Vec<usize> = (0..wet.beam_instance.len()).filter(|&i| wet.beam_instance[i] == NO_HIT).collect();
+        let from_drops = (0..wet.len()).filter(|&p| wet.class[p] == CLASS_NONE).collect::<Vec<_>>();
+        for &p in &from_drops {
+            assert_eq!(wet.instance[p], NO_HIT);
+            assert!(wet.range[p] >= 0.5 && f64::from(wet.range[p]) <= drops.max_range() + 1e-3, "{}", wet.range[p]);
+        }
+        let on_misses = from_drops.iter().filter(|&&p| wet.beam_instance[wet.ray_index[p] as usize] == NO_HIT).count();
+        let expected = 1.0 - (-drops.expected_count(f64::INFINITY)).exp();
+        let n = misses.len() as f64;
+        let sd = (n * expected * (1.0 - expected)).sqrt();
+        eprintln!("{on_misses} drop returns on {n} beams meeting nothing; expected {:.1} ± {sd:.1}", n * expected);
+        assert!(n > 40_000.0 && expected > 0.002, "{n} beams, p = {expected}");
+        assert!((on_misses as f64 - n * expected).abs() < 4.5 * sd);
+        // The wall's own returns: as in dry air, but where a drop outshone them.
+        let walls = |scan: &LidarScan| scan.class.iter().filter(|&&k| k == 10).count();
+        assert_eq!(walls(&dry) - walls(&wet), from_drops.len() - on_misses);
+        // A wall 2 m off: drop points only in front of it.
+        let near = wall_scene(2.0);
+        let wet = lidar.scan(&near, &RigidPose::IDENTITY, &rain, 8).unwrap_or_else(|e| unreachable!("{e}"));
+        let pattern = lidar.pattern();
+        for p in (0..wet.len()).filter(|&p| wet.class[p] == CLASS_NONE) {
+            let i = wet.ray_index[p] as usize;
+            if wet.beam_instance[i] != NO_HIT {
+                assert!(wet.range[p] < 2.0 / pattern[i][0], "a drop behind the wall: {}", wet.range[p]);
+            }
+        }
+        // No drops with a line for a beam, or without rain.
+        let line = Lidar::new(LidarConfig { beam_divergence: 0.0, ..c }).unwrap_or_else(|e| unreachable!("{e}"));
+        let a = line.scan(&s, &RigidPose::IDENTITY, &rain, 8).unwrap_or_else(|e| unreachable!("{e}"));
+        assert_eq!(a, dry);
+        let bad = LidarConfig { beam_divergence: f32::NAN, ..cfg(4, 8) };
+        assert!(Lidar::new(bad).is_err_and(|e| e.to_string().contains("lidar.beam_divergence")));
     }
 
     #[test]
@@ -533,7 +636,8 @@ mod tests {
         };
         let lidar = Lidar::new(c.clone()).unwrap_or_else(|e| unreachable!("{e}"));
         let pose = RigidPose::from_xyz_rpy([0.0, 0.0, 3.0], [0.0; 3]);
-        let env = LidarEnv { fog_extinction_per_m: 3.0 / 600.0, wave_height_m: 1.5, wind_speed_m_s: 9.0 };
+        let env =
+            LidarEnv { fog_extinction_per_m: 3.0 / 600.0, wave_height_m: 1.5, wind_speed_m_s: 9.0, rain_mm_per_h: 0.0 };
         let scan = lidar.scan(&s, &pose, &env, 4).unwrap_or_else(|e| unreachable!("{e}"));
         let dirs: Vec<[f32; 3]> =
             lidar.pattern().iter().map(|d| pose.transform_vector(Vec3::from_array(*d)).to_array()).collect();

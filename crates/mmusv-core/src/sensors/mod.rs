@@ -1,7 +1,7 @@
 //! Sensors, all sampling one frozen [`crate::Scene`] state:
 //! - [`rays`]: ray patterns (spinning LiDAR sweeps, pinhole cameras);
 //! - [`lidar`]: the spinning multi-channel LiDAR with noise, dropout, water returns and weather
-//!   ([`lidar_water`]: returns from the displaced sea surface);
+//!   ([`lidar_water`]: returns from the displaced sea surface; [`lidar_rain`]: returns from rain drops);
 //! - [`camera`]: pinhole and orthographic (top-view) cameras giving depth, semantic, instance and RGB;
 //! - [`radar`]: the rotating ray-cast marine radar ([`radar_model`]: its intensity, rain and clutter
 //!   formulas) and [`ppi`]: the PPI image at a fixed metres-per-pixel scale;
@@ -13,6 +13,7 @@
 pub mod camera;
 pub mod capture;
 pub mod lidar;
+pub mod lidar_rain;
 pub mod lidar_water;
 pub mod noise;
 pub mod ppi;

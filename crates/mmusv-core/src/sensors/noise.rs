@@ -21,6 +21,8 @@ pub mod stream {
     pub const RIPPLE: u64 = 6;
     /// The directions of a camera's traced water reflections (`camera/glossy.rs`).
     pub const GLOSSY: u64 = 7;
+    /// The rain drops a LiDAR beam meets (`super::lidar_rain`).
+    pub const RAIN_DROPS: u64 = 8;
 }
 
 #[inline]
