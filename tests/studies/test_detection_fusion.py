@@ -93,6 +93,37 @@ def test_detector_ignores_water_own_platform_and_is_deterministic() -> None:
     assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
 
 
+def test_detector_leaves_out_the_rain_drops_about_the_sensor() -> None:
+    """In rain (10 mm/h) the LiDAR's drop returns about the sensor (``sensors/lidar_rain.rs``) made a box there,
+    scored 0.98, without the rain step; with it no box lies within 6 m, and the boxes of the same frame without rain
+    are the same with the step and without it (it leaves a dry cloud alone)."""
+    import yaml
+    from mmusv.bundled import resolve_scenario
+    from mmusv.simulation import Simulation
+
+    with open(resolve_scenario("open_sea_convoy")) as fh:
+        spec = yaml.safe_load(fh)
+    clouds = {}
+    for rain in (0.0, 10.0):
+        if rain:
+            spec["environment"].update(weather="rain", rain_mm_per_h=rain)
+        sim = Simulation(spec)
+        lidar = sim.capture(0, sensors=["lidar"]).agents["usv_1"].lidar
+        assert lidar is not None
+        clouds[rain] = np.column_stack([lidar.xyz, lidar.intensity]).astype(np.float32)
+    off = BaselineParams(rain_radius_m=0.0)
+    wet_on, wet_off = baseline_detect(clouds[10.0])[0], baseline_detect(clouds[10.0], off)[0]
+    assert (np.hypot(wet_off[:, 0], wet_off[:, 1]) < 3.0).any(), "the drops no longer make a box: test is void"
+    assert len(wet_on) and (np.hypot(wet_on[:, 0], wet_on[:, 1]) > 6.0).all()
+    dry_on, dry_off = baseline_detect(clouds[0.0]), baseline_detect(clouds[0.0], off)
+    assert len(dry_on[0]) and np.array_equal(dry_on[0], dry_off[0]) and np.array_equal(dry_on[1], dry_off[1])
+    # A bright hull 4 m off is no drop: kept.
+    rng = np.random.default_rng(3)
+    near = np.array([4.5, 0.0, -0.5, 5.0, 2.0, 2.0, 0.0])
+    pts = np.concatenate([water(rng), box_surface(near, rng, n=400)]).astype(np.float32)
+    assert (np.hypot(*baseline_detect(pts)[0][:, :2].T) < 8.0).any()
+
+
 def test_water_plane_follows_tilt() -> None:
     rng = np.random.default_rng(2)
     xy = rng.uniform(-80, 80, (4000, 2))

@@ -24,7 +24,14 @@ model of the paper (a PointPillars-style network), so its absolute numbers are n
    above it, where those returns cover at least ``sea_cells`` (400) cells of 2 m (a calm sea returns from too
    little water to tell: the fixed height stands; returns stacked more than ``sea_stack_m``, 1 m, high in
    a 1 m column, a hull's side, are not water and are left out). Without it, a W3 sea's crests leave clusters
-   of water all round the ego (docs/studies/detection.md, *A baseline that sees the sea*);
+   of water all round the ego (docs/studies/detection.md, *A baseline that sees the sea*). In rain the LiDAR
+   returns from the drops in its beams near the sensor (``sensors/lidar_rain.rs``): of the kept points, those
+   within ``rain_radius_m`` (6 m) of the sensor fainter than ``rain_intensity`` (0.025; a drop returns at most
+   water's Fresnel reflectance, 0.02) are left out too (:func:`rain_clutter`), the low-intensity outlier test of
+   LIOR (Park, Park & Kim 2020, "Fast and Accurate Desnowing Algorithm for LiDAR Point Clouds", IEEE Access 8)
+   within a fixed radius; the water plane and the sea's height still see every point (so a cloud without rain
+   gives the boxes it gave before this step, 2026-12-08). Without it the drops about the sensor made a box there,
+   scored 0.98, in every frame of rain;
 3. the kept points are binned into 0.5 m BEV cells and the cells are clustered by single linkage with a
    range-adaptive gap (``max(gap_m, gap_per_m · range)``: the LiDAR's point spacing grows with range);
 4. each cluster gets the minimum-area rectangle of its points (shapely), with length along the longer side;
@@ -63,6 +70,7 @@ __all__ = [
     "closeness_axis",
     "fit_box",
     "load_detector",
+    "rain_clutter",
     "sea_height",
     "water_plane",
 ]
@@ -100,6 +108,8 @@ class BaselineParams:
     max_length_m: float = 320.0
     max_width_m: float = 50.0
     support_half: float = 20.0
+    rain_radius_m: float = 6.0
+    rain_intensity: float = 0.025
 
 
 def water_plane(points: np.ndarray, *, cell_m: float = 10.0, rounds: int = 3, tol_m: float = 1.0) -> np.ndarray:
@@ -328,6 +338,19 @@ def linked_pairs(centres: np.ndarray, gap: np.ndarray, *, growth: float = 2.0) -
     return np.concatenate(found).astype(np.int64) if found else np.zeros((0, 2), dtype=np.int64)
 
 
+def rain_clutter(points: np.ndarray, params: BaselineParams | None = None) -> np.ndarray:
+    """Step 2 of the module docstring, its rain: the ``(N,)`` bool mask of the ``points`` ``(N, 4)`` (ego LiDAR
+    frame, metres, intensity) that look like rain drops: nearer the sensor than ``params.rain_radius_m`` (3D range)
+    and fainter than ``params.rain_intensity``."""
+    prm = params or BaselineParams()
+    p = np.asarray(points, dtype=np.float64)
+    if p.shape[0] == 0:
+        return np.zeros(0, dtype=bool)
+    near = np.einsum("ij,ij->i", p[:, :3], p[:, :3]) < prm.rain_radius_m**2
+    faint: np.ndarray = near & (p[:, 3] < prm.rain_intensity)
+    return faint
+
+
 def baseline_detect(points: np.ndarray, params: BaselineParams | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The baseline detector (see the module docstring): ``points`` ``(N, 4)`` float32 in the ego LiDAR frame →
     boxes ``(M, 7)`` float64 and scores ``(M,)`` float64, sorted by descending score then position."""
@@ -336,7 +359,7 @@ def baseline_detect(points: np.ndarray, params: BaselineParams | None = None) ->
     if p.shape[0] == 0:
         return np.zeros((0, 7)), np.zeros(0)
     keep, _, (a, b, c), _ = above_water(p, prm)
-    q = p[keep]
+    q = p[keep & ~rain_clutter(p, prm)]
     if q.shape[0] < prm.min_points:
         return np.zeros((0, 7)), np.zeros(0)
     cell = np.floor(q[:, :2] / prm.cell_m).astype(np.int64)
