@@ -28,7 +28,9 @@ with the new one, draws the same frames from the same poses. Each view is writte
 * ``wake_kelvin``: a 20 m motor yacht at 7 m/s on calm water (W0), from 25 m up, 130 m off its wake;
 * ``wake_bend``: a pilot boat at 10 m/s 100 m past a right-angle turn, in a still USV's top view (north up);
 * ``lidar_bulk_100m``: the points of the default 64-channel LiDAR and of a dense 128-channel one on a 190 m bulk
-  carrier whose centre line is 100 m off, in the ship's frame (side and plan views, coloured by intensity).
+  carrier whose centre line is 100 m off, in the ship's frame (side and plan views, coloured by intensity);
+* ``lidar_rain``: the default LiDAR's points around a still USV in rain of 10 mm/h (W1, a tug 25 m off), plan
+  view 30 m and 6 m about the sensor, the points of class 0 (rain drops, since 2026-12-08) in red.
 """
 
 from __future__ import annotations
@@ -462,6 +464,44 @@ def lidar_bulk_100m(path: Path, label: str) -> None:
     plt.close(fig)
 
 
+def lidar_rain(path: Path, label: str) -> None:
+    """Plan views (LiDAR frame, 30 m and 6 m about the sensor) of the default LiDAR's points on a still USV in rain
+    of 10 mm/h (W1, 12:00, a 32 m tug 25 m off), frame 0; class 0 (a drop: nothing else returns with it) red, the
+    water blue, the rest grey."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    tug = {"id": "tug", "asset": "tug_32m", "speed_mps": 0.0, "route": _route(*_at(60.0, 25.0), 150.0)}
+    rig = {"lidar": {}, "radar": None, "cameras": [], "top_view": None}
+    env = {"time_of_day": "12:00", "weather": "rain", "rain_mm_per_h": 10.0, "wave": "W1"}
+    sim = mmusv.Simulation(_scenario("lidar_rain", rig=rig, vessels=[tug], environment=env))
+    points = sim.capture(0, sensors=["lidar"]).agents["observer"].lidar
+    assert points is not None
+    xyz, cls = np.asarray(points.xyz, dtype=np.float64), np.asarray(points.semantic_class)
+    drop = cls == 0
+    fig, axes = plt.subplots(1, 2, figsize=(12, 6), layout="constrained")
+    for ax, half, dot in ((axes[0], 30.0, 1.5), (axes[1], 6.0, 6.0)):
+        for sel, colour, name in ((cls == 1, "tab:blue", "water"), (~drop & (cls != 1), "0.45", "other")):
+            ax.scatter(xyz[sel, 0], xyz[sel, 1], s=dot, c=colour, lw=0, label=f"{name} ({int(sel.sum()):,})")
+        ax.scatter(xyz[drop, 0], xyz[drop, 1], s=dot, c="red", lw=0, label=f"class 0: rain drops ({int(drop.sum()):,})")
+        ax.set_xlim(-half, half)
+        ax.set_ylim(-half, half)
+        ax.set_aspect("equal")
+        ax.set_xlabel("x (bow), m")
+        ax.set_ylabel("y (port), m")
+        ax.grid(alpha=0.3)
+    axes[0].legend(loc="upper left", fontsize=8, markerscale=4)
+    fig.suptitle(
+        f"{label}: default 64-channel LiDAR, rain 10 mm/h, W1; {len(points):,} points, "
+        f"{int(drop.sum()):,} of class 0 (left 30 m, right 6 m about the sensor)",
+        fontsize=10,
+    )
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
 VIEWS: dict[str, Callable[[Path], None]] = {
     "port_entry_preview": port_entry_preview,
     "container_150m": container_150m,
@@ -483,21 +523,25 @@ VIEWS: dict[str, Callable[[Path], None]] = {
 }
 
 
+LABELLED: dict[str, Callable[[Path, str], None]] = {"lidar_bulk_100m": lidar_bulk_100m, "lidar_rain": lidar_rain}
+"""The views that write their label into the picture."""
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", required=True, type=Path, help="output folder")
     parser.add_argument("--label", required=True, choices=["before", "after"], help="suffix of the file names")
-    parser.add_argument("--only", nargs="*", choices=[*VIEWS, "lidar_bulk_100m"], help="render only these views")
+    parser.add_argument("--only", nargs="*", choices=[*VIEWS, *LABELLED], help="render only these views")
     args = parser.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
     print(f"mmusv from {Path(mmusv.__file__).parent}", file=sys.stderr)
-    for name in [*VIEWS, "lidar_bulk_100m"]:
+    for name in [*VIEWS, *LABELLED]:
         if args.only and name not in args.only:
             continue
         path = args.out / f"{name}_{args.label}.png"
         t0 = time.perf_counter()
-        if name == "lidar_bulk_100m":
-            lidar_bulk_100m(path, args.label)
+        if name in LABELLED:
+            LABELLED[name](path, args.label)
         else:
             VIEWS[name](path)
         print(f"{path}  {time.perf_counter() - t0:.1f} s", file=sys.stderr)
