@@ -150,8 +150,9 @@ class LidarConfig(_Model):
     recorded. ``rotation_hz`` sets the columns per sweep only: each frame (``acquisition.frequency_hz``) records
     one whole sweep whatever it is.
 
-    One return per ray: the first surface the ray meets, a ray being a line (a part thinner than the gap between
-    rays, a railing, is met or missed whole; no second or last return). Fog and rain lose returns (two-way
+    One return per ray: the first surface the ray meets, a ray being a line for the surfaces it meets (its divergence
+    is the rain's alone, below: a part thinner than the gap between rays, a railing, is met or missed whole; no
+    second or last return). Fog and rain lose returns (two-way
     transmission). In rain (``environment.rain_mm_per_h`` > 0) the drops in the beam return too, LISA's model
     (Kilic et al. 2021; ``crates/mmusv-core/src/sensors/lidar_rain.rs``): the beam is a cone of full angle
     ``beam_divergence_mrad`` (3 mrad, LISA's; 0 meets no drop), its drops Marshall–Palmer's, and the strongest of
