@@ -2,7 +2,8 @@
 
 Class ids are ``uint16`` in Rust and in the sensors' numpy arrays (the annotation columns widen them to uint32, the
 Parquet tables and :class:`~mmusv.recording.decode.WorldFrame` to int64). ``0`` means "nothing hit" (sky, no
-return; the radar's rain clutter has it too). The palette is the one the quick-look images use (``mmusv preview``'s
+return; the radar's rain clutter has it too, and so do the LiDAR's returns from rain drops, the only LiDAR points
+of class 0). The palette is the one the quick-look images use (``mmusv preview``'s
 semantic panels, SemanticKITTI's ``color_map``): ``PALETTE[class_id]`` is an ``(R, G, B)`` uint8 triple. The
 recorded semantic images are not coloured: their PNGs hold the class ids themselves, 16-bit gray
 (``docs/recording.md``).
@@ -24,7 +25,7 @@ class SemanticClass(IntEnum):
     """Semantic class ids (stable: they are written into recordings), and what of the world carries each:
 
     ==================  =========================================================================================
-    ``NONE`` 0          nothing hit: the sky, no return (and the radar's rain clutter)
+    ``NONE`` 0          nothing hit: the sky, no return (and the radar's rain clutter, the LiDAR's rain drops)
     ``WATER`` 1         the sea's surface, flat or displaced, on the map and past its edge (and the radar's sea
                         clutter)
     ``TERRAIN`` 2       the land, and the seabed of the terrain cells that reach less than 2 m under the surface
