@@ -93,30 +93,57 @@ def test_detector_ignores_water_own_platform_and_is_deterministic() -> None:
     assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
 
 
-def test_detector_leaves_out_the_rain_drops_about_the_sensor() -> None:
-    """In rain (10 mm/h) the LiDAR's drop returns about the sensor (``sensors/lidar_rain.rs``) made a box there,
-    scored 0.98, without the rain step; with it no box lies within 6 m, and the boxes of the same frame without rain
-    are the same with the step and without it (it leaves a dry cloud alone)."""
+def _convoy_agents(rain: float) -> list[AgentFrame]:
+    """The three USVs of ``open_sea_convoy`` at frame 0, LiDAR only, in rain of ``rain`` mm/h (0: its own overcast
+    sky)."""
     import yaml
     from mmusv.bundled import resolve_scenario
     from mmusv.simulation import Simulation
 
     with open(resolve_scenario("open_sea_convoy")) as fh:
         spec = yaml.safe_load(fh)
-    clouds = {}
-    for rain in (0.0, 10.0):
-        if rain:
-            spec["environment"].update(weather="rain", rain_mm_per_h=rain)
-        sim = Simulation(spec)
-        lidar = sim.capture(0, sensors=["lidar"]).agents["usv_1"].lidar
-        assert lidar is not None
-        clouds[rain] = np.column_stack([lidar.xyz, lidar.intensity]).astype(np.float32)
+    if rain:
+        spec["environment"].update(weather="rain", rain_mm_per_h=rain)
+    cap = Simulation(spec).capture(0, sensors=["lidar"])
+    out = []
+    for name, ac in sorted(cap.agents.items()):
+        assert ac.lidar is not None and ac.lidar_pose is not None
+        cloud = np.column_stack([ac.lidar.xyz, ac.lidar.intensity]).astype(np.float32)
+        out.append(AgentFrame(name, cloud, ac.lidar_pose, np.eye(4)))
+    return out
+
+
+def _at(sensors: np.ndarray, boxes: np.ndarray, scores: np.ndarray) -> np.ndarray:
+    """The scores of the ``boxes`` centred within 3 m (BEV) of any of the ``sensors`` ``(K, 2)``."""
+    d = np.hypot(boxes[:, None, 0] - sensors[None, :, 0], boxes[:, None, 1] - sensors[None, :, 1])
+    out: np.ndarray = scores[(d < 3.0).any(axis=1)]
+    return out
+
+
+def test_detector_leaves_out_the_rain_drops_about_the_sensor() -> None:
+    """In rain (10 mm/h) the LiDAR's drop returns about the sensor (``sensors/lidar_rain.rs``) made a box there,
+    scored 0.98, without the rain step; with it no box lies within 6 m, and the boxes of the same frame without rain
+    are the same with the step and without it (it leaves a dry cloud alone). Early fusion: the drops about each
+    neighbour's sensor made a box there, scored 0.97-0.99; each cloud now leaves its drops out in its own frame
+    first (``rain_free``), which leaves the dry clouds' early fusion as it was."""
+    dry, wet = _convoy_agents(0.0), _convoy_agents(10.0)
     off = BaselineParams(rain_radius_m=0.0)
-    wet_on, wet_off = baseline_detect(clouds[10.0])[0], baseline_detect(clouds[10.0], off)[0]
+    wet_on, wet_off = baseline_detect(wet[0].points)[0], baseline_detect(wet[0].points, off)[0]
     assert (np.hypot(wet_off[:, 0], wet_off[:, 1]) < 3.0).any(), "the drops no longer make a box: test is void"
     assert len(wet_on) and (np.hypot(wet_on[:, 0], wet_on[:, 1]) > 6.0).all()
-    dry_on, dry_off = baseline_detect(clouds[0.0]), baseline_detect(clouds[0.0], off)
+    dry_on, dry_off = baseline_detect(dry[0].points), baseline_detect(dry[0].points, off)
     assert len(dry_on[0]) and np.array_equal(dry_on[0], dry_off[0]) and np.array_equal(dry_on[1], dry_off[1])
+    for agents, raining in ((wet, True), (dry, False)):
+        for k, ego in enumerate(agents):
+            nbs = agents[:k] + agents[k + 1 :]
+            sensors = np.array([relative(ego, nb)[:2, 3] for nb in nbs])
+            fused, scores = fuse("early", ego, nbs, detector=baseline_detect)
+            raw, raw_scores = baseline_detect(early_points(ego, nbs, crop_m=220.0))
+            if raining:
+                assert (_at(sensors, raw, raw_scores) > 0.9).any(), "no drop box at a neighbour: test is void"
+                assert (_at(sensors, fused, scores) < 0.9).all(), f"{ego.id}: {_at(sensors, fused, scores)}"
+            else:
+                assert np.array_equal(fused, raw) and np.array_equal(scores, raw_scores)
     # A bright hull 4 m off is no drop: kept.
     rng = np.random.default_rng(3)
     near = np.array([4.5, 0.0, -0.5, 5.0, 2.0, 2.0, 0.0])

@@ -31,7 +31,8 @@ model of the paper (a PointPillars-style network), so its absolute numbers are n
    LIOR (Park, Park & Kim 2020, "Fast and Accurate Desnowing Algorithm for LiDAR Point Clouds", IEEE Access 8)
    within a fixed radius; the water plane and the sea's height still see every point (so a cloud without rain
    gives the boxes it gave before this step, 2026-12-08). Without it the drops about the sensor made a box there,
-   scored 0.98, in every frame of rain;
+   scored 0.98, in every frame of rain (which the study's evaluation ignores, as it ignores every box centred on a
+   USV: a user of the detector saw it);
 3. the kept points are binned into 0.5 m BEV cells and the cells are clustered by single linkage with a
    range-adaptive gap (``max(gap_m, gap_per_m · range)``: the LiDAR's point spacing grows with range);
 4. each cluster gets the minimum-area rectangle of its points (shapely), with length along the longer side;
@@ -71,6 +72,7 @@ __all__ = [
     "fit_box",
     "load_detector",
     "rain_clutter",
+    "rain_free",
     "sea_height",
     "water_plane",
 ]
@@ -110,6 +112,7 @@ class BaselineParams:
     support_half: float = 20.0
     rain_radius_m: float = 6.0
     rain_intensity: float = 0.025
+    rain_points: int = 20
 
 
 def water_plane(points: np.ndarray, *, cell_m: float = 10.0, rounds: int = 3, tol_m: float = 1.0) -> np.ndarray:
@@ -349,6 +352,31 @@ def rain_clutter(points: np.ndarray, params: BaselineParams | None = None) -> np
     near = np.einsum("ij,ij->i", p[:, :3], p[:, :3]) < prm.rain_radius_m**2
     faint: np.ndarray = near & (p[:, 3] < prm.rain_intensity)
     return faint
+
+
+def rain_free(points: np.ndarray, params: BaselineParams | None = None) -> np.ndarray:
+    """The ``points`` ``(N, 4)`` of one LiDAR's own cloud (its frame, metres, intensity) less its rain drops, in
+    their order and dtype: where rain shows (at least ``params.rain_points`` of the faint points near the sensor,
+    :func:`rain_clutter`, lie above its own height plus ``min_height_m``, where no water returns), every such faint
+    near point; else those of them kept above the sea (:func:`above_water`: none of a dry cloud's, so far as
+    checked). Early fusion passes every agent's cloud through it before gathering them
+    (:func:`mmusv.studies.detection.fusion.early_points`): the drops about a neighbour's sensor lie far from the
+    ego's, where :func:`baseline_detect` cannot tell them, and its water plane is not theirs (drops just above a
+    neighbour's water stood above the ego's plane)."""
+    p = np.asarray(points)
+    if p.shape[0] == 0:
+        return p
+    prm = params or BaselineParams()
+    q = p.astype(np.float64)
+    keep = above_water(q, prm)[0]
+    clutter = rain_clutter(q, prm)
+    # Rain shows where faint returns lie about the sensor above its own height, where no water reaches: then every
+    # faint point near it goes (the drops down to the water too, which another sensor's water plane may put above
+    # the sea); else only those kept above the sea (so a dry cloud keeps every point it kept).
+    raining = int(np.count_nonzero(clutter & (q[:, 2] > prm.min_height_m))) >= prm.rain_points
+    drop = clutter if raining else clutter & keep
+    out: np.ndarray = p[~drop]
+    return out
 
 
 def baseline_detect(points: np.ndarray, params: BaselineParams | None = None) -> tuple[np.ndarray, np.ndarray]:
