@@ -15,8 +15,9 @@ consecutively over the converted frames (SemanticKITTI's readers pair scan ``i``
 ``semantic-kitti.yaml`` at the root is the label map in the semantic-kitti-api layout: ``labels`` (id → name),
 ``color_map`` (BGR, from the mmusv palette), ``content`` (fraction of the exported points per class),
 ``learning_map`` (``none`` → 0, the other classes → 1.. in id order; ``none`` labels the returns of rain drops,
-the only points of class 0), ``learning_map_inv``, ``learning_ignore`` (0 only) and ``split`` (``train``/``valid``/``test``: sequence numbers; the split is made by recording,
-:mod:`mmusv.export.splits`; every sequence is ``train`` without a split).
+the only points of class 0), ``learning_map_inv``, ``learning_ignore`` (0 only) and ``split``
+(``train``/``valid``/``test``: sequence numbers; the split is made by recording, :mod:`mmusv.export.splits`; every
+sequence is ``train`` without a split).
 """
 
 from __future__ import annotations

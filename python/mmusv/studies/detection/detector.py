@@ -368,13 +368,14 @@ def rain_free(points: np.ndarray, params: BaselineParams | None = None) -> np.nd
         return p
     prm = params or BaselineParams()
     q = p.astype(np.float64)
-    keep = above_water(q, prm)[0]
     clutter = rain_clutter(q, prm)
+    if not clutter.any():
+        return p
     # Rain shows where faint returns lie about the sensor above its own height, where no water reaches: then every
     # faint point near it goes (the drops down to the water too, which another sensor's water plane may put above
     # the sea); else only those kept above the sea (so a dry cloud keeps every point it kept).
     raining = int(np.count_nonzero(clutter & (q[:, 2] > prm.min_height_m))) >= prm.rain_points
-    drop = clutter if raining else clutter & keep
+    drop = clutter if raining else clutter & above_water(q, prm)[0]
     out: np.ndarray = p[~drop]
     return out
 
