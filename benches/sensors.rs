@@ -1,6 +1,6 @@
 //! `cargo bench --bench sensors`: per-sensor throughput on the synthetic maritime scene (≈0.78 M triangles,
 //! 48 vessels) from an ego USV at the origin — the paper's LiDAR sweep (64 × 410 columns, 131,072 points/s at
-//! 5 Hz), one 640×480 camera with depth + semantic + instance, the same with RGB shading (shadow rays
+//! 5 Hz; also in rain of 10 mm/h, its drops' returns drawn), one 640×480 camera with depth + semantic + instance, the same with RGB shading (shadow rays
 //! included), and a 512×512 top view. Throughput is reported per ray (= per pixel for cameras), criterion's
 //! `elem/s`.
 //!
@@ -53,6 +53,12 @@ fn bench_sensors(c: &mut Criterion) {
     let mut g = c.benchmark_group("sensors");
     g.throughput(Throughput::Elements(lidar.pattern().len() as u64));
     g.bench_function("lidar_sweep_64x410", |b| b.iter(|| black_box(lidar.scan(scene, &lidar_pose, &lenv, 1))));
+    // The same sweep in rain of 10 mm/h with its visibility (Marshall–Palmer, 1.9 km): the drops in the beams
+    // (`sensors/lidar_rain.rs`) besides the air's extinction.
+    let wet = LidarEnv { rain_mm_per_h: 10.0, fog_extinction_per_m: 3.0 / 1900.0, ..lenv };
+    g.bench_function("lidar_sweep_64x410_rain_10mm_h", |b| {
+        b.iter(|| black_box(lidar.scan(scene, &lidar_pose, &wet, 1)))
+    });
     g.throughput(Throughput::Elements(640 * 480));
     g.bench_function("camera_640x480_depth_semantic", |b| {
         b.iter(|| black_box(cam.render(scene, &cam_pose, &env, false, 1)))
